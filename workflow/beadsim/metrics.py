@@ -1,0 +1,45 @@
+"""Per-run metrics: names, units (UDUNITS) and long names, shared by every model.
+
+A model returns a dict whose keys are names from this table (missing keys become NaN in the dataset).
+"""
+
+from __future__ import annotations
+
+METRICS: dict[str, tuple[str, str]] = {
+    # name: (units, long_name)
+    "bead_width_mm": ("mm", "bead width"),
+    "bead_height_mm": ("mm", "bead height above substrate"),
+    "bead_area_mm2": ("mm2", "bead cross-section area above substrate"),
+    "aspect_ratio": ("1", "bead height / width"),
+    "contact_angle_deg": ("degree", "bead contact angle"),
+    "penetration_depth_mm": ("mm", "remelt depth into substrate"),
+    "pool_length_mm": ("mm", "melt pool length"),
+    "pool_width_mm": ("mm", "melt pool width"),
+    "pool_depth_mm": ("mm", "melt pool depth"),
+    "pool_volume_mm3": ("mm3", "melt pool volume"),
+    "T_max_K": ("K", "maximum temperature"),
+    "melt_speed_max_m_s": ("m s-1", "maximum melt speed"),
+    "wire_supply_area_mm2": ("mm2", "wire area fed per unit travel"),
+    "mass_balance_ratio": ("1", "bead area / wire supply area"),
+    "wire_melt_power_W": ("W", "power needed to melt the wire"),
+    "absorbed_power_W": ("W", "absorbed beam power"),
+    "energy_in_J": ("J", "beam energy delivered"),
+    "energy_balance_error": ("1", "energy balance error (relative to energy in)"),
+    "evaporated_energy_J": ("J", "energy removed by the boiling cap"),
+    "boundary_heat_loss_J": ("J", "heat leaving through domain boundaries"),
+    "n_particles": ("1", "number of particles"),
+    "dx_mm": ("mm", "particle spacing"),
+    "dt_s": ("s", "time step"),
+    "sound_speed_m_s": ("m s-1", "artificial sound speed"),
+    "n_steps": ("1", "time steps"),
+    "simulated_time_s": ("s", "simulated process time"),
+    "steady_state_time_s": ("s", "time steady state was detected"),
+    "particle_steps_per_s": ("s-1", "particle-steps per second"),
+    "python_time_share": ("1", "share of wall time outside LAMMPS"),
+    "wall_time_s": ("s", "wall time of the model"),
+    "density_min": ("1", "minimum liquid density / rho0"),
+    "density_max": ("1", "maximum liquid density / rho0"),
+}
+
+# String-valued outputs (not numbers).
+TEXT_OUTPUTS = {"regime": "process regime", "status": "run status", "reason": "failure reason"}
