@@ -30,7 +30,7 @@ METRICS: dict[str, tuple[str, str]] = {
     "n_particles": ("1", "number of particles"),
     "dx_mm": ("mm", "particle spacing"),
     "dt_s": ("s", "time step"),
-    "sound_speed_m_s": ("m s-1", "artificial sound speed"),
+    "sound_speed_used_m_s": ("m s-1", "artificial sound speed used"),
     "n_steps": ("1", "time steps"),
     "simulated_time_s": ("s", "simulated process time"),
     "steady_state_time_s": ("s", "time steady state was detected"),

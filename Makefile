@@ -1,0 +1,51 @@
+# Two commands do everything on a fresh machine (Python 3.11 + pip + gcc):
+#   make run    # environment + the default study + results/report.html
+#   make test   # environment + the test suite
+# Other studies: make run STUDY=<name>   (config/studies/<name>.yaml -> results/<name>/report.html)
+
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+CORES ?= all
+STUDY ?=
+ifeq ($(STUDY),)
+CONFIG ?= config/config.yaml
+REPORT ?= results/report.html
+else
+CONFIG ?= config/studies/$(STUDY).yaml
+REPORT ?= results/$(STUDY)/report.html
+endif
+PROFILE := --workflow-profile workflow/profiles/workstation
+SNAKEMAKE := $(BIN)/snakemake --configfile $(CONFIG) $(PROFILE) --cores $(CORES)
+
+.PHONY: env run report test lint schema bench clean
+
+env: $(STAMP)
+
+$(STAMP): envs/requirements.txt envs/constraints.txt pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet -r envs/requirements.txt -c envs/constraints.txt
+	$(BIN)/pip install --quiet --no-deps -e .
+	touch $(STAMP)
+
+run: env
+	$(SNAKEMAKE)
+	$(MAKE) report
+
+report: env
+	$(SNAKEMAKE) --report $(REPORT)
+	@echo "report: $(REPORT)"
+
+test: env
+	$(BIN)/python -m pytest -q $(PYTEST_ARGS)
+
+lint: env
+	$(BIN)/snakemake --lint --configfile $(CONFIG)
+
+schema: env
+	$(BIN)/python -m beadsim.schema
+
+clean:
+	rm -rf .snakemake logs benchmarks results/*/ results/report.html

@@ -1,0 +1,101 @@
+"""Comparison of runs with the measured beads, and the measured beads' own mass balance."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from beadsim.reduced import cap_area
+from beadsim.study import EXPERIMENT_PARAMS
+
+
+def wire_supply_area(d_mm: float, V_w: float, V_s: float) -> float:
+    """Bead cross-section (mm2) the wire supplies: (pi d^2/4) V_w / V_s."""
+    return math.pi * d_mm**2 / 4 * V_w / V_s
+
+
+def measured_mass_balance(exp: pd.DataFrame, n_sigma: float = 2.0) -> pd.DataFrame:
+    """Does each measured bead hold the metal the wire fed? One row per mode.
+
+    The bead area is taken as a circular cap of the measured width and height (a parabola, 2/3 w h, is shown
+    beside it); the band propagates the stated width/height uncertainties. ``consistent`` is False where the
+    supply lies outside ``n_sigma`` bands of the measured area (both shapes considered).
+    """
+    rows = []
+    for mode, e in exp.iterrows():
+        w, h = e["bead_width_mm"], e["bead_height_mm"]
+        uw, uh = e["bead_width_unc_mm"], e["bead_height_unc_mm"]
+        a_cap = cap_area(w, h)
+        a_par = 2 / 3 * w * h
+        dA_dw = (cap_area(w + 1e-4, h) - cap_area(w - 1e-4, h)) / 2e-4
+        dA_dh = (cap_area(w, h + 1e-4) - cap_area(w, h - 1e-4)) / 2e-4
+        sigma = math.hypot(dA_dw * uw, dA_dh * uh)
+        supply = wire_supply_area(e["wire_diameter_mm"], e["wire_feed_mm_s"], e["substrate_speed_mm_s"])
+        lo, hi = min(a_cap, a_par) - n_sigma * sigma, max(a_cap, a_par) + n_sigma * sigma
+        rows.append({
+            "mode": mode,
+            "material": e["material"],
+            "measured_width_mm": w,
+            "measured_height_mm": h,
+            "bead_area_cap_mm2": a_cap,
+            "bead_area_parabola_mm2": a_par,
+            "bead_area_sigma_mm2": sigma,
+            "wire_supply_area_mm2": supply,
+            "ratio_cap": a_cap / supply,
+            "ratio_parabola": a_par / supply,
+            "consistent": bool(lo <= supply <= hi),
+            "height_if_width_right_mm": _height_for_area(w, supply),
+        })
+    return pd.DataFrame(rows)
+
+
+def _height_for_area(width: float, area: float) -> float:
+    """Height of the circular cap of given width that holds ``area`` (what the mass balance allows)."""
+    lo, hi = 1e-6, 10 * width
+    for _ in range(100):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if cap_area(width, mid) < area else (lo, mid)
+    return (lo + hi) / 2
+
+
+def match_experiments(ds: xr.Dataset, exp: pd.DataFrame) -> dict[str, int]:
+    """Run id -> Table 4 mode, for runs whose process parameters equal a measured mode's."""
+    out = {}
+    for i, case in enumerate(ds["case"].values):
+        for mode, e in exp.iterrows():
+            same = True
+            for k in EXPERIMENT_PARAMS:
+                v = ds[k].values[i]
+                same &= (str(v) == str(e[k])) if isinstance(e[k], str) else bool(np.isclose(float(v), float(e[k])))
+            if same:
+                out[str(case)] = int(mode)
+                break
+    return out
+
+
+def error_table(ds: xr.Dataset, exp: pd.DataFrame) -> pd.DataFrame:
+    """Predicted vs measured width and height, absolute and relative errors, for every matching run."""
+    matched = match_experiments(ds, exp)
+    balance = measured_mass_balance(exp).set_index("mode")
+    rows = []
+    index = {str(c): i for i, c in enumerate(ds["case"].values)}
+    for run_id, mode in matched.items():
+        i = index[run_id]
+        row = {"run_id": run_id, "mode": mode, "model": str(ds["model"].values[i]),
+               "resolution_mm": float(ds["resolution_mm"].values[i]), "status": str(ds["status"].values[i]),
+               "measured_mass_consistent": bool(balance.loc[mode, "consistent"])}
+        for q in ("width", "height"):
+            pred = float(ds[f"bead_{q}_mm"].values[i])
+            meas = float(exp.loc[mode, f"bead_{q}_mm"])
+            row[f"{q}_pred_mm"] = pred
+            row[f"{q}_meas_mm"] = meas
+            row[f"{q}_unc_mm"] = float(exp.loc[mode, f"bead_{q}_unc_mm"])
+            row[f"{q}_err_mm"] = pred - meas
+            row[f"{q}_err_rel"] = (pred - meas) / meas
+        rows.append(row)
+    cols = ["run_id", "mode", "model", "resolution_mm", "status", "measured_mass_consistent"] + [
+        f"{q}_{s}" for q in ("width", "height") for s in ("pred_mm", "meas_mm", "unc_mm", "err_mm", "err_rel")]
+    return pd.DataFrame(rows, columns=cols)

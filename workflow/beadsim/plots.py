@@ -1,0 +1,191 @@
+"""Figures: process maps over swept parameters and parity plots against the measured beads.
+
+Axis labels come from the dataset's ``long_name`` and ``units`` attributes.
+"""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+import seaborn as sns  # noqa: E402
+import xarray as xr  # noqa: E402
+from matplotlib.colors import BoundaryNorm, ListedColormap  # noqa: E402
+
+from beadsim.dataset import swept_parameters  # noqa: E402
+from beadsim.reduced import REGIMES  # noqa: E402
+
+DEFAULT_METRICS = ["bead_width_mm", "bead_height_mm", "aspect_ratio", "pool_length_mm", "regime"]
+REGIME_CMAP = ListedColormap(sns.color_palette("Set2", len(REGIMES)))
+REGIME_NORM = BoundaryNorm(np.arange(-0.5, len(REGIMES)), len(REGIMES))
+
+
+def main_block(ds: xr.Dataset, axes: list[str]) -> xr.Dataset:
+    """The cases that share the most common value of every swept parameter not in ``axes``, and whose axis
+    values are among the most frequent ones (so a stray case off the grid does not break a heat map).
+
+    A study may be a union of blocks (measured modes beside a grid); a map shows the block that varies only
+    along its axes.
+    """
+    keep = np.ones(ds.sizes["case"], dtype=bool)
+    for name in swept_parameters(ds):
+        values, counts = np.unique(ds[name].values[keep], return_counts=True)
+        if name in axes:
+            keep &= np.isin(ds[name].values, values[counts == counts.max()])
+        else:
+            keep &= ds[name].values == values[np.argmax(counts)]
+    return ds.isel(case=np.where(keep)[0])
+
+
+def label(da: xr.DataArray) -> str:
+    """'long name [units]' from a DataArray's attributes."""
+    name = da.attrs.get("long_name", da.name)
+    units = da.attrs.get("units", "")
+    return f"{name} [{units}]" if units and units != "1" else str(name)
+
+
+def _frame(ds: xr.Dataset, cols: list[str]) -> pd.DataFrame:
+    df = pd.DataFrame({c: ds[c].values for c in cols})
+    df["status"] = ds["status"].values
+    df["regime"] = ds["regime"].values
+    return df
+
+
+def process_maps(ds: xr.Dataset, map_x: str | None = None, map_y: str | None = None, map_facet: str | None = None,
+                 map_metrics: list[str] | None = None) -> plt.Figure:
+    """A grid of maps: one row per metric, one column per facet value.
+
+    Two or more swept axes: heat maps on a full (x, y) grid, coloured scatter otherwise (Latin hypercube);
+    failed runs marked with a cross. One swept axis: lines. None: bars per case.
+    """
+    metrics = list(map_metrics or DEFAULT_METRICS)
+    axes = swept_parameters(ds)
+    numeric = [a for a in axes if ds[a].dtype.kind == "f"]
+    x = map_x or (numeric[0] if numeric else None)
+    y = map_y or next((a for a in numeric if a != x), None)
+    facet = map_facet or next((a for a in axes if a not in (x, y)), None)
+    n_all = ds.sizes["case"]
+    if x is not None:
+        ds = main_block(ds, [a for a in (x, y, facet) if a])
+    facet_vals = list(np.unique(ds[facet].values)) if facet else [None]
+    fig, grid = plt.subplots(len(metrics), len(facet_vals), figsize=(4.2 * len(facet_vals), 3.3 * len(metrics)),
+                             squeeze=False)
+    for col, fv in enumerate(facet_vals):
+        sub = ds.isel(case=np.where(ds[facet].values == fv)[0]) if facet else ds
+        for row, metric in enumerate(metrics):
+            ax = grid[row, col]
+            if x is None:
+                _bars(ax, sub, metric)
+            elif y is None:
+                _lines(ax, sub, x, metric)
+            else:
+                _map(ax, sub, x, y, metric)
+            title = f"{facet} = {fv}" if facet else ""
+            ax.set_title(f"{title}\n{metric}" if row == 0 and title else metric, fontsize=9)
+    fig.suptitle(f"{ds.attrs.get('title', '')}: {ds.sizes['case']} of {n_all} runs shown, "
+                 f"{int((ds['status'].values == 'failed').sum())} failed", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def _regime_codes(values) -> np.ndarray:
+    return np.array([REGIMES.index(v) if v in REGIMES else np.nan for v in values], dtype=float)
+
+
+def _map(ax, ds, x, y, metric):
+    df = _frame(ds, [x, y] + ([metric] if metric != "regime" else []))
+    is_regime = metric == "regime"
+    df["value"] = _regime_codes(df["regime"]) if is_regime else df[metric]
+    df.loc[df["status"] != "ok", "value"] = np.nan
+    cmap, norm = (REGIME_CMAP, REGIME_NORM) if is_regime else ("viridis", None)
+    full = df.groupby([y, x]).size().unstack(x)
+    if full.notna().all().all() and len(df) == full.size:
+        table = df.pivot_table(index=y, columns=x, values="value", aggfunc="mean", dropna=False)
+        table = table.sort_index(ascending=False)
+        table.index = [_tick(v) for v in table.index]
+        table.columns = [_tick(v) for v in table.columns]
+        sns.heatmap(table, ax=ax, cmap=cmap, norm=norm, annot=not is_regime, fmt=".2g", cbar=not is_regime,
+                    cbar_kws={"label": label(ds[metric])} if not is_regime else None)
+        failed = df[df["status"] != "ok"]
+        for _, r in failed.iterrows():
+            ax.text(list(table.columns).index(_tick(r[x])) + 0.5, list(table.index).index(_tick(r[y])) + 0.5,
+                    "failed", ha="center", va="center", color="red", fontsize=7)
+    else:
+        ok = df[df["status"] == "ok"]
+        sc = ax.scatter(ok[x], ok[y], c=ok["value"], cmap=cmap, norm=norm, s=40)
+        bad = df[df["status"] != "ok"]
+        ax.scatter(bad[x], bad[y], marker="x", color="red", s=40, label="failed")
+        if not is_regime:
+            fig = ax.figure
+            fig.colorbar(sc, ax=ax, label=label(ds[metric]))
+    if is_regime:
+        present = sorted({r for r in df["regime"] if r in REGIMES}, key=REGIMES.index)
+        handles = [plt.Rectangle((0, 0), 1, 1, color=REGIME_CMAP(REGIMES.index(r))) for r in present]
+        ax.legend(handles, present, fontsize=7, loc="best")
+    ax.set_xlabel(label(ds[x]))
+    ax.set_ylabel(label(ds[y]))
+
+
+def _tick(v) -> str:
+    return f"{v:g}" if isinstance(v, float) else str(v)
+
+
+def _lines(ax, ds, x, metric):
+    order = np.argsort(ds[x].values)
+    xs = ds[x].values[order]
+    ok = ds["status"].values[order] == "ok"
+    if metric == "regime":
+        codes = _regime_codes(ds["regime"].values[order])
+        ax.scatter(xs[ok], codes[ok])
+        ax.set_yticks(range(len(REGIMES)), REGIMES, fontsize=7)
+    else:
+        ys = ds[metric].values[order]
+        ax.plot(xs[ok], ys[ok], "o-")
+        ax.set_ylabel(label(ds[metric]))
+    ax.plot(xs[~ok], np.zeros((~ok).sum()), "rx", label="failed")
+    ax.set_xlabel(label(ds[x]))
+
+
+def _bars(ax, ds, metric):
+    names = [str(c) for c in ds["case"].values]
+    if metric == "regime":
+        ax.barh(names, np.ones(len(names)))
+        for i, r in enumerate(ds["regime"].values):
+            ax.text(0.05, i, r or ds["status"].values[i], va="center", fontsize=8)
+        ax.set_xticks([])
+    else:
+        ax.barh(names, np.nan_to_num(ds[metric].values))
+        ax.set_xlabel(label(ds[metric]))
+
+
+def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
+    """Predicted vs measured bead width and height, one marker per run; hollow where the measured bead fails
+    its own mass balance (the wire fed more metal than the bead holds)."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 4.2))
+    for ax, q in zip(axes, ("width", "height")):
+        meas_all = balance[f"measured_{q}_mm"]
+        lim = [0, 1.25 * max(meas_all.max(), errors[f"{q}_pred_mm"].max() if len(errors) else 0)]
+        ax.plot(lim, lim, "k-", lw=1)
+        ax.fill_between(lim, [v * 0.95 for v in lim], [v * 1.05 for v in lim], color="0.85", label="+-5 %")
+        for k, ((model, res), grp) in enumerate(errors.groupby(["model", "resolution_mm"])):
+            ok = grp[grp["status"] == "ok"]
+            name = model if model == "reduced" else f"{model} dx={res:g} mm"
+            for consistent, part in ok.groupby("measured_mass_consistent"):
+                ax.errorbar(part[f"{q}_meas_mm"], part[f"{q}_pred_mm"], xerr=part[f"{q}_unc_mm"], fmt="o",
+                            color=f"C{k}", mfc=None if consistent else "none",
+                            label=name + ("" if consistent else " (bead fails mass balance)"))
+            for _, r in ok.iterrows():
+                ax.annotate(f"m{r['mode']}", (r[f"{q}_meas_mm"], r[f"{q}_pred_mm"]), fontsize=7,
+                            xytext=(3, 3), textcoords="offset points")
+        if errors.empty:
+            ax.text(0.5, 0.5, "no run matches a measured bead", ha="center", transform=ax.transAxes)
+        ax.set_xlim(lim)
+        ax.set_ylim(lim)
+        ax.set_xlabel(f"measured bead {q} [mm]")
+        ax.set_ylabel(f"predicted bead {q} [mm]")
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig

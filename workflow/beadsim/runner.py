@@ -1,0 +1,70 @@
+"""Run one case with the model it names and record the outcome, whatever happens.
+
+Writes into the run folder:
+- ``params.json``: the resolved parameters;
+- ``result.json``: ``status`` (``ok`` or ``failed``), ``reason``, the metrics, the provenance.
+A failed run is a result: the sweep goes on and aggregation reports it with its reason.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+import traceback
+from pathlib import Path
+
+from beadsim.errors import SimulationFailed
+from beadsim.io import write_json
+from beadsim.materials import get_material
+from beadsim.provenance import provenance
+
+log = logging.getLogger("beadsim.runner")
+
+
+def run_model(params: dict, outdir: Path, materials_file=None) -> dict:
+    """Dispatch to the model named by ``params['model']``; return its metrics."""
+    material = get_material(params["material"], materials_file)
+    if params["model"] == "reduced":
+        from beadsim.reduced import run_reduced
+
+        return run_reduced(params, material)
+    if params["model"] == "sph":
+        from beadsim.sph.driver import run_case
+
+        return run_case(params, outdir, material=material)
+    raise ValueError(f"model {params['model']!r} is not one of reduced, sph")
+
+
+def run_case(params: dict, outdir: str | Path, run_id: str = "", materials_file=None) -> dict:
+    """Run one case and write ``params.json`` and ``result.json`` (atomically) into ``outdir``.
+
+    Returns
+    -------
+    dict
+        The record written to ``result.json``.
+    """
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    write_json(outdir / "params.json", {"run_id": run_id, **params})
+    t0 = time.perf_counter()
+    status, reason, metrics = "ok", "", {}
+    try:
+        metrics = run_model(params, outdir, materials_file)
+    except SimulationFailed as exc:
+        status, reason, metrics = "failed", exc.reason, exc.metrics
+        log.error("run %s failed: %s", run_id, exc.reason)
+    except Exception as exc:  # a failed run must not stop the sweep; the traceback goes to the log
+        status, reason = "failed", f"error: {type(exc).__name__}: {exc}"
+        log.error("run %s raised:\n%s", run_id, traceback.format_exc())
+    record = {
+        "run_id": run_id,
+        "status": status,
+        "reason": reason,
+        "model": params["model"],
+        "metrics": metrics,
+        "elapsed_s": time.perf_counter() - t0,
+        "provenance": provenance(with_lammps=params["model"] == "sph"),
+    }
+    write_json(outdir / "result.json", record)
+    log.info("run %s: %s %s (%.2f s)", run_id, status, reason, record["elapsed_s"])
+    return record

@@ -1,0 +1,72 @@
+"""SPH numerics parameters (read only by the LAMMPS SPH model).
+
+The scene itself (beam, wire, substrate, ``resolution_mm``, ``sim_time_s``) is described by
+:data:`beadsim.parameters.PARAMETERS`; this table adds the knobs of the numerical method. Options that go beyond
+the paper (latent heat, boiling cap, far-field boundary, surface tension, density filter) are switchable here.
+"""
+
+from __future__ import annotations
+
+from beadsim.parameters import Param
+
+_SPH = ("sph",)
+
+SPH_PARAMETERS: list[Param] = [
+    Param("dt_factor", "number", 1.0, "1", "time step as a multiple of the automatic limit (min of acoustic "
+          "CFL, viscous eq. 22, thermal, gravity and capillary limits)", exclusive_minimum=0, maximum=20,
+          short="dtf", models=_SPH, long_name="time-step factor"),
+    Param("sound_speed_m_s", "number", 0.0, "m s-1", "artificial sound speed c0 of the Tait equation of state; "
+          "0 = automatic (10 x the largest expected melt speed, at least sqrt(g H / 0.01))", minimum=0,
+          maximum=1000, short="c0", models=_SPH, long_name="sound speed"),
+    Param("viscosity_model", "string", "artificial", "", "viscous term: artificial (Monaghan, sph/taitwater; "
+          "held in tests) or morris (physical viscosity, eq. 19-20 of the paper; sph/taitwater/morris)",
+          enum=("artificial", "morris"), short="visc", models=_SPH),
+    Param("artificial_viscosity", "number", 0.1, "1", "Monaghan artificial viscosity alpha (viscosity_model "
+          "artificial)", minimum=0, maximum=10, short="av", models=_SPH, long_name="artificial viscosity"),
+    Param("kernel_cutoff_factor", "number", 2.5, "1", "kernel cutoff h as a multiple of the particle spacing "
+          "(Lucy kernel)", minimum=1.2, maximum=5, short="hdx", models=_SPH, long_name="kernel cutoff / dx"),
+    Param("surface_tension", "boolean", False, "", "add a pairwise cohesive (surface tension) force between "
+          "liquid particles (beadsim.sph.tension); off in the paper", short="st", models=_SPH),
+    Param("latent_heat", "boolean", False, "", "latent heat of fusion as an effective heat capacity over "
+          "mushy_range_K above T_melt; off to match the paper", short="lh", models=_SPH),
+    Param("mushy_range_K", "number", 50.0, "K", "temperature range over which the latent heat is released "
+          "(latent_heat true)", exclusive_minimum=0, maximum=1000, short="dTm", models=_SPH,
+          long_name="mushy range"),
+    Param("temperature_cap", "boolean", True, "", "cap temperatures at the boiling point and count the excess "
+          "energy as evaporation", short="cap", models=_SPH),
+    Param("thermal_boundary", "string", "farfield", "", "side/bottom faces of the modelled block that cut the "
+          "plate: farfield (flux k (T-T0)/sqrt(pi a t) into the semi-infinite rest of the plate), insulated "
+          "(zero flux, as in the paper), fixed (held at the preheat temperature). Faces that are real plate "
+          "faces are insulated in every case", enum=("farfield", "insulated", "fixed"), short="bc",
+          models=_SPH),
+    Param("domain", "string", "auto", "", "modelled substrate block: auto (sized from the case: travel, "
+          "scan diameter and domain_margin_mm, never larger than the plate) or plate (the whole "
+          "substrate_*_mm plate)", enum=("auto", "plate"), short="dom", models=_SPH),
+    Param("domain_margin_mm", "number", 3.0, "mm", "margin of the auto block around the scanned track and the "
+          "wire", minimum=0.5, maximum=50, short="marg", models=_SPH, long_name="domain margin"),
+    Param("domain_depth_mm", "number", 3.0, "mm", "thickness of the auto block (at most the plate thickness)",
+          exclusive_minimum=0, maximum=100, short="dep", models=_SPH, long_name="domain depth"),
+    Param("wire_length_mm", "number", 3.0, "mm", "length of wire modelled from its tip to the feed end where "
+          "new slices enter", exclusive_minimum=0, maximum=50, short="Lw", models=_SPH,
+          long_name="modelled wire length"),
+    Param("beam_layers", "integer", 2, "1", "particle layers below the top of each column seen from above "
+          "that share the beam energy of that column", minimum=1, maximum=10, short="bl", models=_SPH),
+    Param("shepard_interval", "integer", 50, "1", "steps between Shepard density filters on the liquid "
+          "(0 = never)", minimum=0, maximum=100000, short="shep", models=_SPH),
+    Param("solid_density_reset", "boolean", True, "", "reset the density of frozen particles to rho0 every "
+          "chunk", short="sdr", models=_SPH),
+    Param("stop_at_steady_state", "boolean", False, "", "stop before sim_time_s once T_max and the melt volume "
+          "are steady", short="ss", models=_SPH),
+    Param("chunk_steps", "integer", 10, "1", "time steps per LAMMPS run chunk (beam deposit, phase update and "
+          "watchdog between chunks)", minimum=1, maximum=10000, short="chunk", models=_SPH),
+    Param("dump_interval_s", "number", 0.05, "s", "process time between particle dumps", exclusive_minimum=0,
+          maximum=60, short="dump", models=_SPH, long_name="dump interval"),
+    Param("restart_interval_s", "number", 0.25, "s", "process time between restart checkpoints",
+          exclusive_minimum=0, maximum=60, short="rst", models=_SPH, long_name="restart interval"),
+    Param("density_tolerance", "number", 0.2, "1", "watchdog: fail when the liquid density leaves "
+          "[1 - tol, 1 + tol] rho0", exclusive_minimum=0, maximum=1, short="rtol", models=_SPH),
+    Param("speed_limit_m_s", "number", 0.0, "m s-1", "watchdog: fail above this particle speed; 0 = half the "
+          "sound speed", minimum=0, maximum=1000, short="vlim", models=_SPH),
+    Param("energy_tolerance", "number", 0.05, "1", "watchdog: fail when the energy balance error exceeds this "
+          "fraction of the beam energy delivered", exclusive_minimum=0, maximum=1, short="etol", models=_SPH),
+]

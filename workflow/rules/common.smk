@@ -1,0 +1,51 @@
+import re
+from pathlib import Path
+
+from snakemake.utils import validate
+
+from beadsim.study import case_params, design, load_experiments
+
+validate(config, schema="../schemas/config.schema.yaml")
+
+STUDY = config["study"]
+ROOT = Path(workflow.basedir)
+
+
+def in_root(path):
+    """A config path relative to the workflow root (absolute paths stay)."""
+    return str(Path(path) if Path(path).is_absolute() else ROOT / path)
+
+
+EXPERIMENTS_FILE = in_root(config.get("experiments_file", "config/experiments.csv"))
+MATERIALS_FILE = in_root(config.get("materials_file", "config/materials.yaml"))
+DESIGN = design(config, load_experiments(EXPERIMENTS_FILE))
+RUN_IDS = list(DESIGN.index)
+OUT = f"results/{STUDY}"
+
+
+wildcard_constraints:
+    run_id="|".join(re.escape(r) for r in RUN_IDS),
+
+
+def get_case(wildcards):
+    """Resolved parameters of one run (a change re-runs it)."""
+    return case_params(DESIGN, wildcards.run_id)
+
+
+def get_results(wildcards=None):
+    return expand(f"{OUT}/runs/{{run_id}}/result.json", run_id=RUN_IDS)
+
+
+def get_benchmarks(wildcards=None):
+    return expand(f"benchmarks/{STUDY}/simulate_bead/{{run_id}}.tsv", run_id=RUN_IDS)
+
+
+def get_final_output():
+    return [
+        f"{OUT}/dataset.nc",
+        f"{OUT}/summary.csv",
+        f"{OUT}/maps/process_maps.png",
+        f"{OUT}/comparison/errors.csv",
+        f"{OUT}/comparison/parity.png",
+        f"{OUT}/comparison/mass_balance.csv",
+    ]

@@ -1,0 +1,15 @@
+rule simulate_bead:
+    output:
+        f"{OUT}/runs/{{run_id}}/result.json",
+    params:
+        case=get_case,
+        materials=MATERIALS_FILE,
+    conda:
+        "../../envs/beadsim.yaml"
+    log:
+        f"logs/{STUDY}/simulate_bead/{{run_id}}.log",
+    benchmark:
+        f"benchmarks/{STUDY}/simulate_bead/{{run_id}}.tsv"
+    threads: 1
+    script:
+        "../scripts/simulate_bead.py"
