@@ -1,0 +1,160 @@
+"""Particle-cloud reductions against synthetic clouds of known shape.
+
+The clouds are cubic lattices of spacing dx (a substrate below z = 0 and a circular-arc cap above it); a
+particle belongs to the cap when its centre lies inside the arc. Tolerances follow from that discretisation:
+
+* width: a bin counts when a whole particle fits under the cap at its centre, so the width is biased low
+  by about dx / tan(theta) and quantised by dx: |error| <= dx / tan(theta) + dx.
+* height: the highest centre lies within dx of the cap top, and its cube reaches dx/2 above it:
+  |error| <= dx/2.
+* area: counting cubes misses or adds at most half a cube along the arc, which cancels on average; a 3 mm wide
+  cap at dx = 0.1 mm is ~ 150 bins, so a few per cent (asserted: 4 %).
+* contact angle: a least-squares circle through ~30 staircase points: within 4 degrees.
+"""
+
+import numpy as np
+import pytest
+
+from beadsim.sph.surface import (
+    bead_cross_section,
+    height_map,
+    lattice_phase,
+    penetration_depth,
+    pool_geometry,
+)
+
+DX = 1e-4  # m
+WIDTH = 3e-3  # m, cap footprint
+WINDOW = (0.0, 2e-3)  # m, x range of the cross-section
+
+
+def lattice(lo, hi, dx=DX):
+    """Cell centres of a cubic lattice filling the box [lo, hi] (m)."""
+    axes = [(np.arange(int(round((b - a) / dx))) + 0.5) * dx + a for a, b in zip(lo, hi)]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
+def cap_shape(width, theta_deg):
+    """Radius, height and area of a circular cap of given footprint width and contact angle (SI)."""
+    theta = np.radians(theta_deg)
+    radius = 0.5 * width / np.sin(theta)
+    height = radius * (1.0 - np.cos(theta))
+    area = radius**2 * theta - (radius - height) * 0.5 * width
+    return radius, height, area
+
+
+def bead_cloud(theta_deg, jitter=0.0, y_shift=0.0, seed=1):
+    """Substrate 2 x 6 x 1 mm below z = 0 plus a cap along x; positions jittered by +-jitter*dx."""
+    radius, height, _ = cap_shape(WIDTH, theta_deg)
+    pos = lattice((0.0, -3e-3 + y_shift, -1e-3), (2e-3, 3e-3 + y_shift, height + 2 * DX))
+    zc = height - radius
+    inside = (pos[:, 2] < 0) | (pos[:, 1] ** 2 + (pos[:, 2] - zc) ** 2 <= radius**2)
+    pos = pos[inside]
+    return pos + np.random.default_rng(seed).uniform(-jitter * DX, jitter * DX, pos.shape)
+
+
+def test_lattice_phase_recovers_offset():
+    values = (np.arange(50) + 0.3) * DX + np.random.default_rng(0).uniform(-0.1, 0.1, 50) * DX
+    assert lattice_phase(values, DX) == pytest.approx(0.3, abs=0.02)
+
+
+def test_flat_substrate_has_zero_height():
+    pos = lattice((0.0, -1e-3, -1e-3), (2e-3, 1e-3, 0.0))
+    y, top = height_map(pos, DX, WINDOW)
+    assert len(y) == 20
+    np.testing.assert_allclose(top, 0.0, atol=1e-12)
+    res = bead_cross_section(pos, DX, WINDOW)
+    assert res["bead_width_mm"] == 0.0
+    assert res["bead_area_mm2"] == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("theta_deg", [30.0, 60.0, 90.0])
+@pytest.mark.parametrize("jitter,y_shift", [(0.0, 0.0), (0.1, 3e-5)])
+def test_cap_cross_section(theta_deg, jitter, y_shift):
+    _, height, area = cap_shape(WIDTH, theta_deg)
+    pos = bead_cloud(theta_deg, jitter, y_shift)
+    res = bead_cross_section(pos, DX, WINDOW)
+    width_tol = DX / np.tan(np.radians(theta_deg)) + DX
+    assert res["bead_width_mm"] == pytest.approx(WIDTH * 1e3, abs=width_tol * 1e3)
+    assert res["bead_height_mm"] == pytest.approx(height * 1e3, abs=0.5 * DX * 1e3 + 1e-9)
+    assert res["bead_area_mm2"] == pytest.approx(area * 1e6, rel=0.04)
+    assert res["contact_angle_deg"] == pytest.approx(theta_deg, abs=4.0)
+
+
+def test_overhanging_cap_width_seen_from_above():
+    """At 120 degrees the widest part (2R) overhangs the footprint; seen from above it is 2R."""
+    radius, _, area = cap_shape(WIDTH, 120.0)
+    res = bead_cross_section(bead_cloud(120.0), DX, WINDOW)
+    assert res["bead_width_mm"] == pytest.approx(2 * radius * 1e3, abs=DX * 1e3)
+    assert res["bead_area_mm2"] == pytest.approx(area * 1e6, rel=0.04)
+    # the fit takes the edges seen from above (at 2R) as contact points: 115 degree, biased low
+    assert res["contact_angle_deg"] == pytest.approx(120.0, abs=7.0)
+
+
+def test_flat_puddle_has_a_small_contact_angle():
+    """One particle layer 3 mm wide: a shallow arc through the edges, 2 atan(2 H / W) = 7.6 degree."""
+    sub = lattice((0.0, -3e-3, -1e-3), (2e-3, 3e-3, 0.0))
+    puddle = lattice((0.0, -1.5e-3, 0.0), (2e-3, 1.5e-3, DX))
+    res = bead_cross_section(np.vstack([sub, puddle]), DX, WINDOW)
+    assert res["bead_width_mm"] == pytest.approx(3.0)
+    assert res["bead_height_mm"] == pytest.approx(0.1)
+    assert res["bead_area_mm2"] == pytest.approx(0.3)
+    assert res["contact_angle_deg"] == pytest.approx(np.degrees(2 * np.arctan(2 * DX / WIDTH)), abs=4.0)
+
+
+def test_stray_particles_do_not_change_the_result():
+    pos = bead_cloud(60.0, jitter=0.1)
+    clean = bead_cross_section(pos, DX, WINDOW)
+    strays = np.array([[1.0e-3, 0.0, 3e-3], [0.55e-3, 2.5e-3, 0.4e-3], [1.25e-3, -2.2e-3, 0.2e-3]])
+    dirty = bead_cross_section(np.vstack([pos, strays]), DX, WINDOW)
+    # the strays only nudge the lattice phase estimate (circular mean over ~8000 particles): 1e-3 relative
+    assert dirty == pytest.approx(clean, rel=1e-3)
+
+
+def test_mask_excludes_material():
+    pos = bead_cloud(60.0)
+    res = bead_cross_section(pos, DX, WINDOW, mask=pos[:, 2] < 0)
+    assert res["bead_width_mm"] == 0.0 and res["bead_height_mm"] == 0.0
+
+
+def test_z_surface_shift():
+    pos = bead_cloud(60.0)
+    base = bead_cross_section(pos, DX, WINDOW)
+    shifted = bead_cross_section(pos + [0.0, 0.0, 0.7e-3], DX, WINDOW, z_surface=0.7e-3)
+    assert shifted == pytest.approx(base, rel=1e-9, abs=1e-9)
+
+
+def ellipsoid_pool(a, b, c):
+    """Lattice particles of a half-ellipsoid below z = 0 (semi-axes a, b in x, y; depth c)."""
+    pos = lattice((-a - DX, -b - DX, -c - DX), (a + DX, b + DX, 0.0))
+    r2 = (pos[:, 0] / a) ** 2 + (pos[:, 1] / b) ** 2 + (pos[:, 2] / c) ** 2
+    return pos[r2 <= 1.0]
+
+
+def test_pool_geometry_ellipsoid():
+    a, b, c = 2.0e-3, 1.0e-3, 0.6e-3
+    pool = ellipsoid_pool(a, b, c)
+    droplet = np.array([[5e-3, 0.0, 1e-3]])  # detached spatter: ignored
+    res = pool_geometry(np.vstack([pool, droplet]), DX)
+    assert res["pool_length_mm"] == pytest.approx(2 * a * 1e3, abs=DX * 1e3)
+    assert res["pool_width_mm"] == pytest.approx(2 * b * 1e3, abs=DX * 1e3)
+    assert res["pool_depth_mm"] == pytest.approx(c * 1e3, abs=0.5 * DX * 1e3 + 1e-9)
+    # half-ellipsoid volume 2/3 pi a b c; surface cells make a few per cent at ~2500 cells
+    assert res["pool_volume_mm3"] == pytest.approx(2.0 / 3.0 * np.pi * a * b * c * 1e9, rel=0.05)
+
+
+def test_pool_geometry_empty():
+    assert pool_geometry(np.empty((0, 3)), DX)["pool_volume_mm3"] == 0.0
+
+
+def test_penetration_depth_of_melted_ellipsoid():
+    a, b, c = 3.0e-3, 1.0e-3, 0.6e-3
+    sub = lattice((-1e-3, -2e-3, -1.5e-3), (1e-3, 2e-3, 0.0))
+    melted = (sub[:, 0] / a) ** 2 + (sub[:, 1] / b) ** 2 + (sub[:, 2] / c) ** 2 <= 1.0
+    # a stray melted particle deep in one column must not count
+    melted[np.argmin(np.hypot(sub[:, 0] - 0.55e-3, sub[:, 1] - 1.5e-3) + np.abs(sub[:, 2] + 1.45e-3))] = True
+    depth = penetration_depth(sub, melted, DX, (-1e-3, 1e-3))
+    # deepest melted centre lies within dx of c; its cube adds dx/2; the median over x reduces it by at most
+    # the arc's drop over |x| <= 1 mm (c (1 - sqrt(1 - 1/9)) = 0.034 mm)
+    assert depth == pytest.approx(c * 1e3, abs=0.5 * DX * 1e3 + 0.034)
+    assert penetration_depth(sub, np.zeros(len(sub), bool), DX, (-1e-3, 1e-3)) == 0.0
