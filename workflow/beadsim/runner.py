@@ -21,21 +21,30 @@ from beadsim.provenance import provenance
 log = logging.getLogger("beadsim.runner")
 
 
-def run_model(params: dict, outdir: Path, materials_file=None) -> dict:
-    """Dispatch to the model named by ``params['model']``; return its metrics."""
+def run_model(params: dict, outdir: Path, materials_file=None, tasks: int = 1, mpi: str = "mpirun") -> dict:
+    """Dispatch to the model named by ``params['model']``; return its metrics.
+
+    SPH runs with ``tasks > 1`` are launched as ``<mpi> -n <tasks> python -m beadsim.sph.mpi_main``; the
+    reduced model always runs in this process.
+    """
     material = get_material(params["material"], materials_file)
     if params["model"] == "reduced":
         from beadsim.reduced import run_reduced
 
         return run_reduced(params, material)
     if params["model"] == "sph":
-        from beadsim.sph.driver import run_case
+        if tasks > 1:
+            from beadsim.sph.mpi_main import run_mpi
 
-        return run_case(params, outdir, material=material)
+            return run_mpi(params, outdir, tasks=tasks, mpi=mpi, materials_file=materials_file)
+        from beadsim.sph.driver import run_case as run_sph
+
+        return run_sph(params, outdir, material=material)
     raise ValueError(f"model {params['model']!r} is not one of reduced, sph")
 
 
-def run_case(params: dict, outdir: str | Path, run_id: str = "", materials_file=None) -> dict:
+def run_case(params: dict, outdir: str | Path, run_id: str = "", materials_file=None, tasks: int = 1,
+             mpi: str = "mpirun") -> dict:
     """Run one case and write ``params.json`` and ``result.json`` (atomically) into ``outdir``.
 
     Returns
@@ -49,7 +58,7 @@ def run_case(params: dict, outdir: str | Path, run_id: str = "", materials_file=
     t0 = time.perf_counter()
     status, reason, metrics = "ok", "", {}
     try:
-        metrics = run_model(params, outdir, materials_file)
+        metrics = run_model(params, outdir, materials_file, tasks=tasks, mpi=mpi)
     except SimulationFailed as exc:
         status, reason, metrics = "failed", exc.reason, exc.metrics
         log.error("run %s failed: %s", run_id, exc.reason)
@@ -61,6 +70,7 @@ def run_case(params: dict, outdir: str | Path, run_id: str = "", materials_file=
         "status": status,
         "reason": reason,
         "model": params["model"],
+        "mpi_tasks": tasks if params["model"] == "sph" else 1,
         "metrics": metrics,
         "elapsed_s": time.perf_counter() - t0,
         "provenance": provenance(with_lammps=params["model"] == "sph"),

@@ -11,5 +11,9 @@ rule simulate_bead:
     benchmark:
         f"benchmarks/{STUDY}/simulate_bead/{{run_id}}.tsv"
     threads: 1
+    resources:
+        # MPI ranks for one SPH run and the launcher (profiles set them: mpirun on a workstation, srun on SLURM).
+        tasks=1,
+        mpi="mpirun",
     script:
         "../scripts/simulate_bead.py"
