@@ -64,6 +64,10 @@ PARAMETERS: list[Param] = [
           minimum=5, maximum=90, short="alpha", long_name="wire angle"),
     Param("wire_height_mm", "number", 1.5, "mm", "height H of the wire axis above the substrate at the beam "
           "axis", minimum=0, maximum=10, short="H", long_name="wire height"),
+    Param("wetting_angle_deg", "number", 0.0, "degree", "equilibrium contact angle of the melt on the solid "
+          "substrate (0 = the material's value in materials.yaml); sets how far a bead spreads beyond the melted "
+          "width (reduced model) and the adhesion strength (SPH with surface tension)", minimum=0, maximum=150,
+          short="wet", long_name="wetting angle"),
     Param("preheat_K", "number", 300.0, "K", "initial (preheat) temperature of substrate and wire",
           minimum=1, maximum=1500, short="T0", long_name="preheat temperature"),
     Param("volumetric_heat_W", "number", 0.0, "W", "extra volumetric heat (induction heating) spread over the "

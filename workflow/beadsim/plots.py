@@ -189,3 +189,50 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
         ax.legend(fontsize=7)
     fig.tight_layout()
     return fig
+
+
+def calibration_plot(curves: dict, table: pd.DataFrame, exp: pd.DataFrame, parameter: str,
+                     attrs: dict) -> plt.Figure:
+    """Width and height against the calibrated parameter per mode, measured values, left-out fits."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 4))
+    xlabel = f"{attrs.get('long_name', parameter)} [{attrs.get('units', '')}]"
+    loo = table.set_index("mode")
+    for k, (mode, c) in enumerate(sorted(curves.items())):
+        for ax, q in zip(axes, ("width", "height")):
+            ax.plot(c[parameter], c[q], "o-", color=f"C{k}", label=f"mode {mode}")
+            ax.axhline(float(exp.loc[mode, f"bead_{q}_mm"]), color=f"C{k}", ls="--", lw=1)
+            x = loo.loc[mode, f"{parameter}_loo"]
+            ax.plot([x], [loo.loc[mode, f"{q}_pred_loo_mm"]], "*", ms=12, color=f"C{k}")
+    for ax, q in zip(axes, ("width", "height")):
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(f"bead {q} [mm]")
+    axes[0].legend(title="dashed: measured; star: left-out fit", fontsize=7, title_fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def convergence_plot(ds: xr.Dataset, table: pd.DataFrame, parameter: str) -> plt.Figure:
+    """Each convergence metric against resolution per group, with the extrapolated value and its GCI band."""
+    metrics = list(pd.unique(table["metric"])) if len(table) else []
+    groups = list(pd.unique(table["group"])) if len(table) else []
+    fig, axes = plt.subplots(1, max(len(metrics), 1), figsize=(3.6 * max(len(metrics), 1), 3.4), squeeze=False)
+    for j, m in enumerate(metrics):
+        ax = axes[0, j]
+        for k, g in enumerate(groups):
+            row = table[(table["group"] == g) & (table["metric"] == m)].iloc[0]
+            pts = sorted((float(c.split("@")[1]), row[c]) for c in table.columns
+                         if c.startswith(f"{m}@") and pd.notna(row[c]))
+            if not pts:
+                continue
+            hs, vs = zip(*pts)
+            ax.plot(hs, vs, "o-", color=f"C{k}", label=str(g))
+            if pd.notna(row.get("extrapolated", np.nan)):
+                ext, band = row["extrapolated"], row["gci_fine"] * abs(row["finest"])
+                ax.errorbar([0], [ext], yerr=[band], fmt="s", color=f"C{k}", capsize=3)
+        ax.set_xlabel(label(ds[parameter]))
+        ax.set_ylabel(label(ds[m]))
+        ax.set_xlim(left=-0.02)
+    if metrics:
+        axes[0, 0].legend(fontsize=7, title="square at 0: extrapolated +- GCI", title_fontsize=7)
+    fig.tight_layout()
+    return fig

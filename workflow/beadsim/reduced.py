@@ -317,7 +317,7 @@ def run_reduced(params: dict, material: Material) -> dict:
         pool = Pool(0.0, 0.0, 0.0, 0.0, T0)
 
     area = math.pi * d**2 / 4 * V_w / V_s  # m2
-    theta_e = math.radians(material.contact_angle_deg)
+    theta_e = math.radians(params["wetting_angle_deg"] or material.contact_angle_deg)
     if area > 0:
         width = max(pool.width, cap_width(area, theta_e))
         theta = cap_angle(width, area)

@@ -106,6 +106,26 @@ def build_schema() -> dict:
                 },
                 },
             },
+            "analysis": {
+                "type": "object",
+                "additionalProperties": False,
+                "description": "analyses run over the study's dataset",
+                "properties": {
+                    "calibration": {
+                        "type": "object",
+                        "additionalProperties": False,
+                        "description": "fit one parameter to Table 1 with leave-one-out cross-validation "
+                                       "(sweep it over the measured modes)",
+                        "properties": {"parameter": {"enum": numeric, "default": "beam_efficiency"}},
+                    },
+                    "convergence": {
+                        "type": "object",
+                        "additionalProperties": False,
+                        "description": "Richardson extrapolation and GCI over a resolution ladder",
+                        "properties": {"parameter": {"enum": numeric, "default": "resolution_mm"}},
+                    },
+                },
+            },
             "report": {
                 "type": "object",
                 "additionalProperties": False,

@@ -41,7 +41,13 @@ def get_benchmarks(wildcards=None):
 
 
 def get_final_output():
-    return [
+    analyses = config.get("analysis", {})
+    extra = []
+    if "calibration" in analyses:
+        extra += [f"{OUT}/calibration/leave_one_out.csv", f"{OUT}/calibration/curves.png"]
+    if "convergence" in analyses:
+        extra += [f"{OUT}/convergence/richardson.csv", f"{OUT}/convergence/convergence.png"]
+    return extra + [
         f"{OUT}/dataset.nc",
         f"{OUT}/summary.csv",
         f"{OUT}/maps/process_maps.png",

@@ -1,0 +1,46 @@
+"""Calibration with leave-one-out validation (on real reduced runs) and Richardson extrapolation."""
+
+import numpy as np
+import pytest
+
+from beadsim.analysis import loo_calibration, richardson
+from beadsim.dataset import build_dataset
+from beadsim.runner import run_case
+from beadsim.study import case_params, design
+
+
+@pytest.mark.parametrize("p", [1.0, 2.0, 3.0])
+def test_richardson_recovers_order_and_limit(p):
+    h = np.array([0.2, 0.3, 0.4])  # non-uniform refinement ratios 1.5 and 1.33
+    f = 3.3 + 0.7 * h**p
+    out = richardson(h, f)
+    assert out["order"] == pytest.approx(p, rel=1e-8)
+    assert out["extrapolated"] == pytest.approx(3.3, rel=1e-10)
+    assert out["monotone"]
+    # GCI brackets the true error of the finest value with the 1.25 safety factor.
+    true_rel = abs(f[0] - 3.3) / f[0]
+    assert out["gci_fine"] == pytest.approx(1.25 * true_rel, rel=1e-8)
+
+
+def test_richardson_flags_oscillation():
+    assert not richardson(np.array([0.2, 0.3, 0.4]), np.array([1.0, 1.1, 1.05]))["monotone"]
+
+
+def test_leave_one_out_never_fits_a_mode_to_itself(tmp_path, experiments):
+    cfg = {"study": "cal", "sweep": [{"cases": [{"experiment": m} for m in (1, 2, 3)],
+                                      "grid": {"beam_efficiency": [0.3, 0.6, 0.9]}}]}
+    table = design(cfg, experiments)
+    results = []
+    for run_id in table.index:
+        run_case(case_params(table, run_id), tmp_path / run_id, run_id=run_id)
+        results.append(tmp_path / run_id / "result.json")
+    ds = build_dataset(results, None, cfg, table)
+    loo, summary = loo_calibration(ds, experiments, "beam_efficiency")
+    assert list(loo["mode"]) == [1, 2, 3]
+    for _, row in loo.iterrows():
+        assert str(row["mode"]) not in row["fit_on_modes"].split()
+        assert 0.3 <= row["beam_efficiency_loo"] <= 0.9
+    # Cross-validated errors are never smaller in total than the errors of the fit to all modes.
+    assert (loo["width_err_rel_loo"] ** 2).sum() >= (loo["width_err_rel_fit"] ** 2).sum() - 1e-12
+    # Width grows with absorbed power, so the calibrated efficiency is where mode 1's width is matched best.
+    assert summary["width_rms_err_rel_loo"] < 0.5

@@ -1,0 +1,179 @@
+"""Study analyses over an aggregated dataset: calibration with leave-one-out validation, grid convergence.
+
+Both work on any model's dataset: they only need the cases, their parameters and metrics.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from beadsim.compare import match_experiments, measured_mass_balance
+
+
+def _targets_for(mode: int, balance: pd.DataFrame) -> list[str]:
+    """Metrics a mass-conserving model can be asked to match for a measured bead.
+
+    Width always; height only where the bead holds the metal the wire fed (otherwise no mass-conserving
+    prediction can match width and height together, and fitting the height would bias the parameter).
+    """
+    return ["width", "height"] if bool(balance.loc[mode, "consistent"]) else ["width"]
+
+
+def response_curves(ds: xr.Dataset, exp: pd.DataFrame, parameter: str) -> dict[int, pd.DataFrame]:
+    """For each measured mode: the ok runs sorted by ``parameter`` with predicted width and height."""
+    matched = match_experiments(ds, exp)
+    index = {str(c): i for i, c in enumerate(ds["case"].values)}
+    curves: dict[int, list] = {}
+    for run_id, mode in matched.items():
+        i = index[run_id]
+        if ds["status"].values[i] != "ok":
+            continue
+        curves.setdefault(mode, []).append({parameter: float(ds[parameter].values[i]),
+                                            "width": float(ds["bead_width_mm"].values[i]),
+                                            "height": float(ds["bead_height_mm"].values[i])})
+    return {m: pd.DataFrame(rows).sort_values(parameter).reset_index(drop=True) for m, rows in curves.items()}
+
+
+def loo_calibration(ds: xr.Dataset, exp: pd.DataFrame, parameter: str = "beam_efficiency",
+                    n_fine: int = 2001) -> tuple[pd.DataFrame, dict]:
+    """Calibrate one parameter against Table 1 with leave-one-out cross-validation.
+
+    The parameter's value for predicting mode m is the one that minimises the summed squared relative error of
+    the *other* modes (width, and height where that bead passes its mass balance), with the metrics linearly
+    interpolated between the swept values. So no mode is predicted by a fit to itself.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        One row per mode: the left-out fit value, predictions and relative errors (cross-validated), the
+        all-modes fit value and its (fitted, not validated) errors.
+    summary : dict
+        All-modes fit value, RMS cross-validated relative errors of width and height.
+    """
+    curves = response_curves(ds, exp, parameter)
+    balance = measured_mass_balance(exp).set_index("mode")
+    modes = sorted(curves)
+    if len(modes) < 2:
+        raise ValueError(f"calibration needs runs of at least two measured modes; found {modes}")
+    lo = max(c[parameter].min() for c in curves.values())
+    hi = min(c[parameter].max() for c in curves.values())
+    grid = np.linspace(lo, hi, n_fine)
+
+    def pred(mode, q, values):
+        c = curves[mode]
+        return np.interp(values, c[parameter], c[q])
+
+    def objective(fit_modes):
+        total = np.zeros_like(grid)
+        for m in fit_modes:
+            for q in _targets_for(m, balance):
+                meas = float(exp.loc[m, f"bead_{q}_mm"])
+                total += ((pred(m, q, grid) - meas) / meas) ** 2
+        return total
+
+    obj_all = objective(modes)
+    best_all = float(grid[np.argmin(obj_all)])
+    # Where the objective is flat the fit is not identifiable: report the whole near-optimal interval.
+    near = grid[obj_all <= obj_all.min() * 1.01 + 1e-9]
+    rows = []
+    for m in modes:
+        others = [o for o in modes if o != m]
+        best = float(grid[np.argmin(objective(others))])
+        row = {"mode": m, "fit_on_modes": " ".join(map(str, others)), f"{parameter}_loo": best,
+               f"{parameter}_all": best_all, "measured_mass_consistent": bool(balance.loc[m, "consistent"])}
+        for q in ("width", "height"):
+            meas = float(exp.loc[m, f"bead_{q}_mm"])
+            p_loo = float(pred(m, q, best))
+            p_all = float(pred(m, q, best_all))
+            row.update({f"{q}_meas_mm": meas, f"{q}_pred_loo_mm": p_loo, f"{q}_err_rel_loo": (p_loo - meas) / meas,
+                        f"{q}_pred_fit_mm": p_all, f"{q}_err_rel_fit": (p_all - meas) / meas})
+        rows.append(row)
+    table = pd.DataFrame(rows)
+    summary = {
+        "parameter": parameter,
+        "range_searched": [float(lo), float(hi)],
+        f"{parameter}_all": best_all,
+        f"{parameter}_all_interval": [float(near.min()), float(near.max())],
+        "identifiable": bool(near.max() - near.min() < 0.05 * (hi - lo)),
+        "width_rms_err_rel_loo": float(np.sqrt(np.mean(table["width_err_rel_loo"] ** 2))),
+        "height_rms_err_rel_loo": float(np.sqrt(np.mean(table["height_err_rel_loo"] ** 2))),
+        "height_rms_err_rel_loo_consistent_modes": float(np.sqrt(np.mean(
+            table.loc[table["measured_mass_consistent"], "height_err_rel_loo"] ** 2)))
+        if table["measured_mass_consistent"].any() else math.nan,
+    }
+    return table, summary
+
+
+def richardson(h: np.ndarray, f: np.ndarray, safety: float = 1.25) -> dict:
+    """Observed order, extrapolated value and grid-convergence index from three resolutions.
+
+    Roache's GCI for possibly non-constant refinement ratios (Celik et al. 2008, J. Fluids Eng. 130, 078001):
+    solves ``(f3 - f2)/(f2 - f1) = (r21^p - 1)/(r32^p - 1) * r32^p ... `` by fixed-point iteration.
+
+    Parameters
+    ----------
+    h : array of 3 floats
+        Resolutions (e.g. particle spacing), any order.
+    f : array of 3 floats
+        The quantity at each resolution.
+
+    Returns
+    -------
+    dict
+        ``order`` (observed p), ``extrapolated`` (f at h -> 0), ``gci_fine`` (relative band of the finest
+        value), ``monotone`` (False for oscillatory convergence, where the order is not meaningful).
+    """
+    order = np.argsort(h)
+    h1, h2, h3 = np.asarray(h, float)[order]
+    f1, f2, f3 = np.asarray(f, float)[order]
+    r21, r32 = h2 / h1, h3 / h2
+    e21, e32 = f2 - f1, f3 - f2
+    if e21 == 0 or e32 == 0:
+        return {"order": math.nan, "extrapolated": f1, "gci_fine": 0.0, "monotone": e21 == e32}
+    s = np.sign(e32 / e21)
+    p = 1.0
+    for _ in range(200):
+        q = math.log((r21**p - s) / (r32**p - s))
+        p_new = abs(math.log(abs(e32 / e21)) + q) / math.log(r21)
+        if abs(p_new - p) < 1e-12:
+            break
+        p = p_new
+    extrap = (r21**p * f1 - f2) / (r21**p - 1)
+    gci = safety * abs((f1 - f2) / f1) / (r21**p - 1) if f1 != 0 else math.nan
+    return {"order": p, "extrapolated": extrap, "gci_fine": gci, "monotone": bool(s > 0)}
+
+
+CONVERGENCE_METRICS = ("bead_width_mm", "bead_height_mm", "pool_length_mm", "pool_width_mm", "pool_depth_mm")
+
+
+def convergence_table(ds: xr.Dataset, parameter: str = "resolution_mm",
+                      metrics=CONVERGENCE_METRICS) -> pd.DataFrame:
+    """Richardson analysis of every group of cases that differ only in ``parameter``.
+
+    Uses the three finest ok resolutions of each group; groups with fewer are reported with NaN order.
+    """
+    from beadsim.dataset import swept_parameters
+
+    others = [p for p in swept_parameters(ds) if p != parameter]
+    keys = pd.DataFrame({p: ds[p].values for p in others}) if others else pd.DataFrame(index=range(ds.sizes["case"]))
+    group_ids = keys.astype(str).agg("_".join, axis=1) if others else pd.Series(["all"] * ds.sizes["case"])
+    rows = []
+    for gid in pd.unique(group_ids):
+        idx = np.where((group_ids == gid).to_numpy() & (ds["status"].values == "ok"))[0]
+        hs = ds[parameter].values[idx]
+        order = np.argsort(hs)[:3]
+        label = str(ds["case_name"].values[idx[0]]) if len(idx) and ds["case_name"].values[idx[0]] else gid
+        for m in metrics:
+            row = {"group": label, "metric": m, "n_ok": len(idx)}
+            vals = ds[m].values[idx][order]
+            for h, v in zip(hs[order], vals):
+                row[f"{m}@{h:g}"] = float(v)
+            if len(idx) >= 3 and np.all(np.isfinite(vals)):
+                row.update(richardson(hs[order], vals))
+                row["finest"] = float(vals[0])
+            rows.append(row)
+    return pd.DataFrame(rows)

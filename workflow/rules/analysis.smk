@@ -1,0 +1,52 @@
+rule calibrate_parameter:
+    input:
+        dataset=f"{OUT}/dataset.nc",
+        experiments=EXPERIMENTS_FILE,
+    output:
+        table=report(
+            f"{OUT}/calibration/leave_one_out.csv",
+            caption="../report/calibration.rst",
+            category="Calibration",
+            labels={"table": "leave-one-out"},
+        ),
+        summary=f"{OUT}/calibration/summary.json",
+        figure=report(
+            f"{OUT}/calibration/curves.png",
+            caption="../report/calibration.rst",
+            category="Calibration",
+            labels={"figure": "response curves"},
+        ),
+    params:
+        parameter=lookup(dpath="analysis/calibration/parameter", within=config, default="beam_efficiency"),
+    conda:
+        "../../envs/beadsim.yaml"
+    log:
+        f"logs/{STUDY}/calibrate_parameter.log",
+    script:
+        "../scripts/calibrate_parameter.py"
+
+
+rule analyze_convergence:
+    input:
+        f"{OUT}/dataset.nc",
+    output:
+        table=report(
+            f"{OUT}/convergence/richardson.csv",
+            caption="../report/convergence.rst",
+            category="Convergence",
+            labels={"table": "Richardson / GCI"},
+        ),
+        figure=report(
+            f"{OUT}/convergence/convergence.png",
+            caption="../report/convergence.rst",
+            category="Convergence",
+            labels={"figure": "metrics vs resolution"},
+        ),
+    params:
+        parameter=lookup(dpath="analysis/convergence/parameter", within=config, default="resolution_mm"),
+    conda:
+        "../../envs/beadsim.yaml"
+    log:
+        f"logs/{STUDY}/analyze_convergence.log",
+    script:
+        "../scripts/analyze_convergence.py"

@@ -1,0 +1,20 @@
+"""Leave-one-out calibration of one parameter against Table 1."""
+
+import xarray as xr
+
+from beadsim.analysis import loo_calibration, response_curves
+from beadsim.io import atomic_path, save_figure, write_json
+from beadsim.logs import configure_logging
+from beadsim.plots import calibration_plot
+from beadsim.study import load_experiments
+
+configure_logging(snakemake.log[0])
+ds = xr.load_dataset(snakemake.input.dataset)
+exp = load_experiments(snakemake.input.experiments)
+parameter = snakemake.params.parameter
+table, summary = loo_calibration(ds, exp, parameter)
+with atomic_path(snakemake.output.table) as tmp:
+    table.to_csv(tmp, index=False)
+write_json(snakemake.output.summary, summary)
+save_figure(calibration_plot(response_curves(ds, exp, parameter), table, exp, parameter, ds[parameter].attrs),
+            snakemake.output.figure)
