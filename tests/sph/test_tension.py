@@ -1,0 +1,150 @@
+"""Surface tension and wetting of the pairwise cohesive SPH model, with real LAMMPS (tiny scenes).
+
+Run: /tmp/venv/bin/pytest tests/sph/test_tension.py -v   (about 1 minute on one idle core)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from beadsim.lammps_env import new_lammps
+from beadsim.materials import get_material
+from beadsim.sph import verify_tension as vt
+from beadsim.sph.tension import CONTACT_ANGLE_HYSTERESIS, CohesionModel, wetting_ratio_for_angle
+
+TI = get_material("Ti-Gr2")
+DX = 3.0e-4
+#: The settings the calibration tables were measured with: c0 10 m/s, artificial viscosity 0.2, dt 5 us.
+SETTINGS = dict(dx=DX, c0=10.0, alpha=0.2, dt=5e-6)
+
+
+def _two_particle_lammps(model: CohesionModel, table):
+    """Two solid (type 2) particles 0.6 h apart with the SPH and cohesive styles of the bead driver."""
+    lmp = new_lammps()
+    for cmd in (
+        "units si",
+        "atom_style sph",
+        "atom_modify map array",
+        "region b block -3e-3 3e-3 -3e-3 3e-3 -3e-3 3e-3 units box",
+        "create_box 2 b",
+        "create_atoms 2 single 0 0 0 units box",
+        f"create_atoms 2 single {0.6 * model.h} 0 0 units box",
+        f"mass * {TI.rho * DX**3}",
+        f"set group all sph/rho {TI.rho}",
+        f"neighbor {0.3 * DX} bin",
+        "pair_style hybrid/overlay sph/taitwater " + model.pair_style_tokens(),
+        f"pair_coeff * * sph/taitwater {TI.rho} 10 0.2 {model.h}",
+        *model.pair_coeff_commands([1], [2], table_file=table),
+        "fix 1 all sph",
+        "timestep 1e-9",
+        "thermo 0",
+        "run 0 post no",
+    ):
+        lmp.command(cmd)
+    return lmp
+
+
+def test_table_reproduces_the_force(tmp_path):
+    """LAMMPS' interpolated table gives the analytic force and energy (pair_write): to 0.1 % of s, plus 0.5 %
+    of the local force in the steep repulsive core (LAMMPS interpolates linearly in r^2)."""
+    model = CohesionModel.from_material(TI, DX, wetting_ratio=0.8)
+    lmp = new_lammps()
+    try:
+        for cmd in (
+            "units si",
+            "atom_style sph",
+            "region b block 0 1e-2 0 1e-2 0 1e-2 units box",
+            "create_box 2 b",
+            "mass * 1e-7",
+            f"pair_style hybrid/overlay zero {model.h} {model.pair_style_tokens()}",
+            "pair_coeff * * zero",
+            *model.pair_coeff_commands([1], [2], table_file=tmp_path / "t.table"),
+        ):
+            lmp.command(cmd)
+        lmp.command(f"pair_write 1 1 200 r {0.05 * model.h} {0.999 * model.h} {tmp_path / 'll.txt'} LL")
+        lmp.command(f"pair_write 1 2 200 r {0.05 * model.h} {0.999 * model.h} {tmp_path / 'ls.txt'} LS")
+    finally:
+        lmp.close()
+    for name, s in (("ll.txt", model.s_ll), ("ls.txt", model.s_ls)):
+        r, e, f = np.loadtxt(tmp_path / name, skiprows=5, usecols=(1, 2, 3)).T
+        exact = model.force(r, s)
+        assert np.all(np.abs(f - exact) < 1e-3 * s + 5e-3 * np.abs(exact))
+        assert np.abs(e - model.energy(r, s)).max() < 1e-3 * s * model.h
+
+
+@pytest.mark.parametrize("pre, cohesive", [("no", False), ("yes", True)])
+def test_type_change_needs_setup(tmp_path, pre, cohesive):
+    """After a solid particle turns liquid, the cohesive force appears only once the run does its setup.
+
+    The cohesive sub-style covers liquid pairs only, so pair hybrid gives it a type-filtered neighbour list
+    that ``run N pre no`` does not rebuild.
+    """
+    model = CohesionModel.from_material(TI, DX, wetting_ratio=0.9)
+    lmp = _two_particle_lammps(model, tmp_path / "t.table")
+    try:
+        assert lmp.numpy.extract_atom("f")[0, 0] == 0.0  # solid-solid: no cohesion, no SPH pressure at rho0
+        lmp.numpy.extract_atom("type")[0] = 1  # particle 1 melts
+        lmp.command(f"run 1 pre {pre} post no")
+        fx = lmp.numpy.extract_atom("f")[0, 0]
+    finally:
+        lmp.close()
+    expected = -model.force(0.6 * model.h, model.s_ls)  # attraction pulls particle 1 towards +x
+    assert fx == (pytest.approx(expected, rel=1e-3) if cohesive else 0.0)
+
+
+def test_slab_tension_matches_the_calibration():
+    """Kirkwood-Buff virial tension of a flat periodic slab equals the material's sigma within 10 %."""
+    res = vt.slab_tension(TI, settings=vt.SceneSettings(**SETTINGS))
+    assert res["sigma_N_m"] == pytest.approx(TI.surface_tension, rel=0.10)
+    assert 0.98 < res["rho_mean_rel"] < 1.02
+
+
+def test_free_drop_laplace_pressure():
+    """Free drops stay nearly round and their core pressure (pair virial, time-averaged) follows 2 sigma / R.
+
+    Tolerances are the scatter measured at dx 0.3 mm over R = 6-10 dx (core pressure / (2 sigma / R) =
+    1.24, 0.69, 0.50, 0.66 for R = 1.8, 2.1, 2.4, 3.0 mm): the particle arrangement gives the liquid a
+    spurious yield stress of the order of the Laplace pressure at this resolution, and the drops freeze
+    10-20 % out of round (a sphere cut from the lattice reads 0.05-0.08 on the same measure).
+    """
+    ratios = []
+    for radius in (1.8e-3, 2.4e-3):
+        res = vt.free_drop(TI, radius=radius, t_end=4e-3, t_average=2e-3, settings=vt.SceneSettings(**SETTINGS))
+        assert res["laplace_analytic_Pa"] == pytest.approx(2 * TI.surface_tension / res["radius_m"])
+        ratios.append(res["laplace_virial_Pa"] / res["laplace_analytic_Pa"])
+        assert res["roundness"] < 0.25
+        assert res["vmax_final_m_s"] < 0.3
+        assert 0.93 < res["rho_min_final_rel"] and res["rho_max_final_rel"] < 1.07
+    assert all(0.4 < r < 1.6 for r in ratios)
+    assert np.mean(ratios) == pytest.approx(1.0, abs=0.35)
+
+
+def test_sessile_drop_contact_angle():
+    """Drops started above and below the set angle settle on either side of it, as the table says.
+
+    The ratio for 79 degrees (0.9) is taken from the table; advancing (from a hemisphere) and receding (from a
+    50 degree cap) angles must match the tabulated ones within 8 degrees and their mean the set angle within
+    6 degrees. The drop is smaller than the one the table was measured with (442 particles instead of 1052).
+    """
+    target = 79.0
+    ratio = wetting_ratio_for_angle(target)
+    _, advancing, receding = next(row for row in CONTACT_ANGLE_HYSTERESIS if row[0] == pytest.approx(ratio))
+    measured = []
+    for start in (90.0, 50.0):
+        res = vt.sessile_drop(
+            TI,
+            wetting_ratio=ratio,
+            radius=1.8e-3,
+            plate_half_width=4.2e-3,
+            plate_layers=3,
+            initial_angle_deg=start,
+            t_end=0.012,
+            settings=vt.SceneSettings(**SETTINGS),
+        )
+        assert res["n_liquid"] == res["n_liquid_initial"]
+        assert abs(res["angle_height_deg"] - res["angle_deg"]) < 8.0  # a spherical cap, no spreading film
+        measured.append(res["angle_deg"])
+    assert measured[0] == pytest.approx(advancing, abs=8.0)
+    assert measured[1] == pytest.approx(receding, abs=8.0)
+    assert np.mean(measured) == pytest.approx(target, abs=6.0)

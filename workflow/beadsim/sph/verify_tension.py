@@ -1,0 +1,644 @@
+"""Verification scenes for the cohesive surface-tension model, run with real LAMMPS.
+
+Each scene uses the bead driver's ingredients: ``atom_style sph``, ``pair_style hybrid/overlay sph/taitwater
+sph/heatconduction`` plus the cohesive sub-style of :class:`beadsim.sph.tension.CohesionModel`, ``fix sph`` on
+all particles, the solid (type 2) frozen with ``fix setforce 0 0 0``, and a chunked loop
+(``run N pre no post no``) that resets solid velocity and density from Python between chunks.
+
+Public functions
+----------------
+free_drop(...) -> dict
+    A spherical drop in vacuum: Laplace pressure inside (time-averaged pair virial of the core, and Tait
+    pressure) against 2 sigma / R, roundness.
+sessile_drop(...) -> dict
+    A drop on a frozen plate, started as a spherical cap of a chosen angle: contact angle from a sphere fitted
+    to its free surface, from its apex height and from its centroid height.
+slab_tension(...) -> dict
+    Kirkwood-Buff virial surface tension of a periodic liquid slab (the calibration route).
+calibrate(...) -> dict
+    C_sigma = sigma dx / s from slabs at several strengths.
+benchmark(...) -> dict
+    Particle-steps per second of the SPH styles with and without the cohesive term in a chunked loop.
+roundness(x, dx), cap_angle_from_surface(x, dx), cap_angle_from_centroid(volume, z_c)
+    Shape measures used by the above.
+
+Settings the tables of :mod:`beadsim.sph.tension` were measured with: ``SceneSettings(c0=10, alpha=0.2,
+dt=5e-6)`` at dx 0.3 mm.
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import brentq
+from scipy.spatial import cKDTree
+
+from beadsim.lammps_env import new_lammps
+from beadsim.materials import Material, get_material
+from beadsim.sph.tension import CohesionModel
+
+LIQUID, SOLID = 1, 2
+
+
+@dataclass
+class SceneSettings:
+    """Numerical settings shared by the scenes (SI units).
+
+    Attributes
+    ----------
+    dx : float
+        Particle spacing, m.
+    c0 : float
+        Tait sound speed, m s-1.
+    alpha : float
+        Artificial viscosity of sph/taitwater (dimensionless).
+    morris_viscosity : float or None
+        If given, use ``sph/taitwater/morris`` with this dynamic viscosity (Pa s) instead of ``sph/taitwater``.
+    dt : float or None
+        Time step, s; None = :meth:`CohesionModel.dt_limit` for c0 and alpha.
+    chunk : int
+        Steps per ``run N pre no post no`` chunk.
+    skin : float or None
+        Neighbour skin, m; None = 0.3 dx.
+    backend : str
+        Cohesive backend, ``"table"``, ``"lepton"`` or ``"none"`` (no cohesion).
+    """
+
+    dx: float = 3.0e-4
+    c0: float = 10.0
+    alpha: float = 0.2
+    morris_viscosity: float | None = None
+    dt: float | None = None
+    chunk: int = 10
+    skin: float | None = None
+    backend: str = "table"
+
+
+def _setup(lmp, st: SceneSettings, half: tuple[float, float, float], boundary: str = "f f f"):
+    """Create the box (half widths in m) and neighbour settings; atoms are added by the caller afterwards."""
+    hx, hy, hz = half
+    for cmd in (
+        "units si",
+        "atom_style sph",
+        "dimension 3",
+        f"boundary {boundary}",
+        "atom_modify map array",
+        "comm_modify vel yes",
+        f"neighbor {st.skin if st.skin is not None else 0.3 * st.dx:.6g} bin",
+        "neigh_modify every 1 delay 0 check yes",
+        f"region box block {-hx:.6g} {hx:.6g} {-hy:.6g} {hy:.6g} {-hz:.6g} {hz:.6g} units box",
+        "create_box 2 box",
+        f"lattice sc {st.dx:.6g}",
+    ):
+        lmp.command(cmd)
+
+
+def _finish_setup(
+    lmp, mat: Material, model: CohesionModel, st: SceneSettings, cohesive_types: tuple[int, ...] = (LIQUID,)
+) -> float:
+    """Set masses, pair styles, fixes and the time step; return dt (s).
+
+    ``cohesive_types`` get the liquid-liquid cohesion among themselves (the benchmark adds the solid to measure
+    an unfiltered neighbour list); the other types get the liquid-solid one.
+    """
+    m = mat.rho * st.dx**3
+    lmp.command(f"mass * {m:.9g}")
+    lmp.command(f"set group all sph/rho {mat.rho}")
+    lmp.command(f"set group all sph/cv {mat.cp}")
+    lmp.command(f"set group all sph/e {mat.cp * mat.T_melt:.9g}")
+    lmp.command("group liquid type 1")
+    lmp.command("group solid type 2")
+    extra = "" if st.backend == "none" else " " + model.pair_style_tokens()
+    sph = "sph/taitwater" if st.morris_viscosity is None else "sph/taitwater/morris"
+    visc = st.alpha if st.morris_viscosity is None else st.morris_viscosity
+    lmp.command(f"pair_style hybrid/overlay {sph} sph/heatconduction" + extra)
+    rho0 = mat.rho if st.backend == "none" else model.tait_rho0(mat, st.c0)
+    lmp.command(f"pair_coeff * * {sph} {rho0:.9g} {st.c0} {visc} {model.h:.9g}")
+    lmp.command(f"pair_coeff * * sph/heatconduction {mat.diffusivity:.9g} {model.h:.9g}")
+    if st.backend != "none":
+        others = [t for t in (LIQUID, SOLID) if t not in cohesive_types]
+        with tempfile.TemporaryDirectory() as tmp:  # LAMMPS reads the table during pair_coeff
+            for line in model.pair_coeff_commands(list(cohesive_types), others, Path(tmp) / "tension.table"):
+                lmp.command(line)
+    lmp.command("fix integrate all sph")
+    lmp.command("fix freeze solid setforce 0 0 0")
+    dt = st.dt or model.dt_limit(mat, st.dx, st.c0, st.alpha)
+    lmp.command(f"timestep {dt:.9g}")
+    lmp.command("thermo 0")
+    return dt
+
+
+def _local(lmp, name: str) -> np.ndarray:
+    """Live view of per-atom property ``name`` for the local atoms only (LAMMPS may append ghost atoms)."""
+    return lmp.numpy.extract_atom(name)[: lmp.extract_global("nlocal")]
+
+
+def _run_chunks(lmp, nsteps: int, st: SceneSettings, rho0: float, history_every: int = 0) -> dict:
+    """Run ``nsteps`` in chunks, resetting solid velocity and density between chunks.
+
+    Returns wall time, particle-steps per second, the largest liquid speed and density range over the run and
+    at its end (``*_final``); with ``history_every`` > 0 chunks also ``history``: rows (step, vmax, rho_min,
+    rho_max) every that many chunks.
+    """
+    lmp.command("run 0 post no")
+    solid = _local(lmp, "type") == SOLID
+    liq = ~solid
+    vmax, rho_lo, rho_hi, history = 0.0, np.inf, -np.inf, []
+    nchunks = max(1, nsteps // st.chunk)
+    t0 = time.perf_counter()
+    for k in range(nchunks):
+        lmp.command(f"run {st.chunk} pre no post no")
+        if lmp.extract_global("nlocal") != len(solid):
+            raise RuntimeError(f"particles left the box after {(k + 1) * st.chunk} steps: the scene blew up")
+        v = _local(lmp, "v")
+        rho = _local(lmp, "rho")
+        v[solid] = 0.0
+        rho[solid] = rho0
+        v_now = float(np.sqrt((v[liq] ** 2).sum(axis=1)).max())
+        lo, hi = float(rho[liq].min()) / rho0, float(rho[liq].max()) / rho0
+        vmax, rho_lo, rho_hi = max(vmax, v_now), min(rho_lo, lo), max(rho_hi, hi)
+        if history_every and (k + 1) % history_every == 0:
+            history.append(((k + 1) * st.chunk, v_now, lo, hi))
+    wall = time.perf_counter() - t0
+    n = lmp.get_natoms()
+    out = {
+        "wall_s": wall,
+        "steps": nchunks * st.chunk,
+        "particles": n,
+        "particle_steps_per_s": n * nchunks * st.chunk / wall,
+        "vmax_m_s": vmax,
+        "rho_min_rel": rho_lo,
+        "rho_max_rel": rho_hi,
+        "vmax_final_m_s": v_now,
+        "rho_min_final_rel": lo,
+        "rho_max_final_rel": hi,
+    }
+    if history_every:
+        out["history"] = history
+    return out
+
+
+def _liquid_state(lmp, mat: Material, model: CohesionModel, st: SceneSettings, n_avg: int) -> dict:
+    """Liquid positions and pressures averaged over the next ``n_avg`` steps (run here, in chunks).
+
+    ``p_eos`` is the Tait pressure of the time-averaged density with the shifted reference density, minus the
+    background pressure -P_pair (so 0 in a bulk at the lattice state); ``p_virial`` is the time-averaged
+    per-atom pair virial pressure (SPH plus cohesive forces) with volume m / rho. Positions are the final ones;
+    ``stats`` are the run statistics of the averaging window.
+    """
+    n_avg = max(st.chunk, n_avg // st.chunk * st.chunk)
+    lmp.command("reset_timestep 0")  # fix ave/atom reports on multiples of n_avg
+    lmp.command("compute vir all stress/atom NULL virial")
+    lmp.command("compute rhoa all sph/rho/atom")
+    lmp.command(f"fix avg all ave/atom 1 {n_avg} {n_avg} c_vir[1] c_vir[2] c_vir[3] c_rhoa")
+    stats = _run_chunks(lmp, n_avg, st, mat.rho)
+    liq = _local(lmp, "type") == LIQUID
+    avg = np.array(lmp.numpy.extract_fix("avg", 1, 2)[: len(liq)][liq])
+    rho = avg[:, 3]
+    rho0 = model.tait_rho0(mat, st.c0)
+    b = rho0 * st.c0**2 / 7.0
+    return {
+        "x": np.array(_local(lmp, "x")[liq]),
+        "rho": rho,
+        "p_eos": b * ((rho / rho0) ** 7 - 1.0) + model.pair_pressure(),
+        # stress/atom holds -p V per atom (pressure * volume); volume per particle = m / rho
+        "p_virial": -avg[:, :3].sum(axis=1) / 3.0 / (mat.rho * st.dx**3 / rho),
+        "stats": stats,
+    }
+
+
+def _model(mat: Material, st: SceneSettings, strength: float | None, wetting_ratio: float) -> CohesionModel:
+    """CohesionModel for the scene; ``strength`` overrides s_ll (N) for calibration runs."""
+    backend = "table" if st.backend == "none" else st.backend
+    model = CohesionModel.from_material(mat, st.dx, wetting_ratio=wetting_ratio, backend=backend)
+    return model if strength is None else model.with_strength(strength)
+
+
+def free_drop(
+    material: str | Material = "Ti-Gr2",
+    radius: float = 1.5e-3,
+    t_end: float = 4e-3,
+    t_average: float = 2e-3,
+    strength: float | None = None,
+    settings: SceneSettings | None = None,
+    log: str | None = None,
+    history_every: int = 0,
+) -> dict:
+    """Relax a spherical liquid drop in vacuum (no gravity) and measure its Laplace pressure.
+
+    Parameters
+    ----------
+    material : str or Material
+        Material key or object (rho, cp, surface_tension, ...).
+    radius : float
+        Radius of the initial sphere cut from the lattice, m.
+    t_end : float
+        Relaxation time, s.
+    t_average : float
+        Averaging time after relaxation, s.
+    strength : float, optional
+        s_ll, N; default: sized by the calibration for the material's surface tension.
+    settings : SceneSettings, optional
+        Numerical settings.
+    log : str, optional
+        LAMMPS log file.
+    history_every : int
+        Record (step, vmax, rho range) every this many chunks (0 = no history).
+
+    Returns
+    -------
+    dict
+        ``radius_m`` (equivalent radius from the particle volume), ``laplace_eos_Pa`` and ``laplace_virial_Pa``
+        (mean Tait pressure / mean virial pressure of particles deeper than h below the surface; outside is
+        vacuum, p = 0), ``laplace_analytic_Pa`` (2 sigma / R with the model's nominal sigma), ``sigma_eos_N_m``
+        (= laplace_eos * R / 2), ``s_ll_N``, ``roundness`` (:func:`roundness`),
+        ``dt_s`` and the run statistics of :func:`_run_chunks`.
+    """
+    mat = get_material(material) if isinstance(material, str) else material
+    st = settings or SceneSettings()
+    model = _model(mat, st, strength, 1.0)
+    lmp = new_lammps(log=log)
+    try:
+        half = radius + 3 * model.h
+        _setup(lmp, st, (half, half, half))
+        lmp.command(f"region drop sphere 0 0 0 {radius:.9g} units box")
+        lmp.command(f"create_atoms {LIQUID} region drop")
+        dt = _finish_setup(lmp, mat, model, st)
+        stats = _run_chunks(lmp, int(round(t_end / dt)), st, mat.rho, history_every)
+        state = _liquid_state(lmp, mat, model, st, int(round(t_average / dt)))
+        stats.update({k: v for k, v in state["stats"].items() if "_final_" in k})  # end of the averaging
+    finally:
+        lmp.close()
+    x = state["x"] - state["x"].mean(axis=0)
+    n = len(x)
+    r_eq = (3 * n * st.dx**3 / (4 * math.pi)) ** (1 / 3)
+    core = np.linalg.norm(x, axis=1) < r_eq - model.h
+    p_eos = float(state["p_eos"][core].mean())
+    return {
+        "radius_m": r_eq,
+        "n_liquid": n,
+        "n_core": int(core.sum()),
+        "laplace_eos_Pa": p_eos,
+        "laplace_eos_std_Pa": float(state["p_eos"][core].std()),
+        "laplace_virial_Pa": float(state["p_virial"][core].mean()),
+        "laplace_analytic_Pa": 2 * model.sigma / r_eq if strength is None else float("nan"),
+        "sigma_eos_N_m": p_eos * r_eq / 2,
+        "s_ll_N": model.s_ll,
+        "roundness": roundness(x, st.dx),
+        "dt_s": dt,
+        **stats,
+    }
+
+
+def roundness(x: np.ndarray, dx: float, directions: int = 500) -> float:
+    """Out-of-roundness of a particle cloud centred at the origin: (max - min) / mean of its support function
+    max_i(x_i . n) + dx / 2 over ``directions`` quasi-uniform unit vectors n (0 for a sphere; 0.73 for a cube).
+    """
+    k = np.arange(directions) + 0.5
+    polar = np.arccos(1 - 2 * k / directions)
+    azim = np.pi * (1 + 5**0.5) * k
+    n = np.c_[np.sin(polar) * np.cos(azim), np.sin(polar) * np.sin(azim), np.cos(polar)]
+    support = (x @ n.T).max(axis=0) + dx / 2
+    return float((support.max() - support.min()) / support.mean())
+
+
+def cap_angle_from_surface(x: np.ndarray, dx: float, z_min: float | None = None) -> tuple[float, float]:
+    """Contact angle (degree) and radius (m) of the sphere fitted to the free-surface particles of a drop
+    resting on the plane z = 0.
+
+    Surface particles are those with fewer than 3/4 of the 90th-percentile number of neighbours within 2.5 dx
+    (a bulk particle has ~65-80, one on a flat surface about half); only those above ``z_min`` (default 1.5 dx, which leaves out the first layer and any precursor film)
+    enter an algebraic least-squares sphere fit, whose radius is then enlarged by dx / 2 (a particle fills
+    dx / 2 beyond its centre). With the centre at height z0, cos(theta) = -z0 / R.
+    """
+    z_min = 1.5 * dx if z_min is None else z_min
+    counts = np.array([len(n) for n in cKDTree(x).query_ball_point(x, 2.5 * dx)])
+    pts = x[(counts < 0.75 * np.percentile(counts, 90)) & (x[:, 2] > z_min)]
+    a = np.c_[2 * pts, np.ones(len(pts))]
+    sol, *_ = np.linalg.lstsq(a, (pts**2).sum(axis=1), rcond=None)
+    centre = sol[:3]
+    radius = math.sqrt(sol[3] + centre @ centre) + dx / 2
+    return math.degrees(math.acos(np.clip(-centre[2] / radius, -1.0, 1.0))), radius
+
+
+def cap_angle_from_centroid(volume: float, z_centroid: float) -> float:
+    """Contact angle (degree) of the spherical cap of ``volume`` (m3) whose centroid sits ``z_centroid`` (m)
+    above its base.
+
+    A cap of a sphere of radius R with contact angle theta (c = cos theta) has height H = R (1 - c), volume
+    V = pi R^3 (2 - 3c + c^3) / 3 and its centroid 3 (2R - H)^2 / (4 (3R - H)) from the sphere centre, i.e.
+    that minus (R - H) above the base; the equation z_c(theta) = ``z_centroid`` is solved by bisection.
+    """
+
+    def z_of(theta: float) -> float:
+        c = math.cos(theta)
+        shape = (2 - 3 * c + c**3) / 3
+        big_r = (volume / (math.pi * shape)) ** (1 / 3)
+        h = big_r * (1 - c)
+        return 3 * (2 * big_r - h) ** 2 / (4 * (3 * big_r - h)) - (big_r - h)
+
+    lo, hi = 1e-3, math.pi - 1e-3
+    if z_centroid <= z_of(lo):
+        return 0.0  # flatter than any cap: a spreading film
+    return math.degrees(brentq(lambda t: z_of(t) - z_centroid, lo, hi))
+
+
+def sessile_drop(
+    material: str | Material = "Ti-Gr2",
+    wetting_ratio: float = 1.0,
+    radius: float = 2.1e-3,
+    plate_half_width: float = 5.1e-3,
+    plate_layers: int = 4,
+    gravity: float = 0.0,
+    initial_angle_deg: float = 90.0,
+    t_end: float = 0.02,
+    t_average: float = 1e-3,
+    strength: float | None = None,
+    settings: SceneSettings | None = None,
+    log: str | None = None,
+    history_every: int = 0,
+) -> dict:
+    """Relax a hemispherical drop on a frozen plate and measure its contact angle.
+
+    The plate (type 2, ``plate_layers`` layers, top layer centred at z = -dx/2 so its surface is z = 0) is held
+    by ``fix setforce``; the liquid (type 1) starts as a spherical cap, by default the upper half of a sphere of
+    ``radius`` (90 degrees).
+
+    Parameters
+    ----------
+    material : str or Material
+        Material key or object.
+    wetting_ratio : float
+        s_ls / s_ll.
+    radius : float
+        Radius of the initial hemisphere, m.
+    plate_half_width : float
+        Half width of the square plate, m.
+    plate_layers : int
+        Particle layers of the plate.
+    gravity : float
+        Gravitational acceleration on the liquid, m s-2 (0 keeps the cap exactly spherical).
+    initial_angle_deg : float
+        Contact angle of the initial spherical cap (same volume as the hemisphere of ``radius``); starting
+        below the final angle measures a receding angle, above it an advancing one.
+    t_end : float
+        Relaxation time, s.
+    t_average : float
+        Averaging time after relaxation, s.
+    strength : float, optional
+        s_ll, N; default sized from the material's surface tension.
+    settings : SceneSettings, optional
+        Numerical settings.
+    log : str, optional
+        LAMMPS log file.
+    history_every : int
+        Record (step, vmax, rho range) every this many chunks (0 = no history).
+
+    Returns
+    -------
+    dict
+        ``angle_centroid_deg`` (from volume and centroid height), ``angle_height_deg``
+        (2 atan(H / a) from the top height H and the base radius a of a cap with the drop's volume),
+        ``angle_deg`` (sphere fitted to the free surface above 1.5 dx, :func:`cap_angle_from_surface`; the
+        primary measure), ``height_m``, ``base_radius_m``, ``n_liquid`` and ``n_liquid_initial`` (atoms lost
+        through the plate or the box show as a difference), ``x_liquid_m`` (final liquid positions),
+        ``wetting_ratio`` and the run statistics.
+    """
+    mat = get_material(material) if isinstance(material, str) else material
+    st = settings or SceneSettings()
+    model = _model(mat, st, strength, wetting_ratio)
+    dx = st.dx
+    lmp = new_lammps(log=log)
+    try:
+        top = radius * 1.6 + 2 * model.h
+        _setup(lmp, st, (plate_half_width, plate_half_width, top))
+        # lattice sites sit at integer multiples of dx: shift by dx/2 in z so the plate surface is z = 0
+        lmp.command(f"lattice sc {dx:.6g} origin 0 0 0.5")
+        lmp.command(
+            f"region plate block {-plate_half_width:.9g} {plate_half_width:.9g} {-plate_half_width:.9g} "
+            f"{plate_half_width:.9g} {-plate_layers * dx:.9g} 0 units box"
+        )
+        lmp.command(f"create_atoms {SOLID} region plate")
+        # initial cap with contact angle initial_angle_deg and the volume of the hemisphere of ``radius``
+        c = math.cos(math.radians(initial_angle_deg))
+        cap_r = radius * (2 / (2 - 3 * c + c**3)) ** (1 / 3)
+        lmp.command(f"region cap sphere 0 0 {-cap_r * c:.9g} {cap_r:.9g} side in units box")
+        lmp.command("region upper block INF INF INF INF 0 INF units box")
+        lmp.command("region hemi intersect 2 cap upper")
+        lmp.command(f"create_atoms {LIQUID} region hemi")
+        dt = _finish_setup(lmp, mat, model, st)
+        n_initial = int((_local(lmp, "type") == LIQUID).sum())
+        if gravity:
+            lmp.command(f"fix grav liquid gravity {gravity} vector 0 0 -1")
+        stats = _run_chunks(lmp, int(round(t_end / dt)), st, mat.rho, history_every)
+        state = _liquid_state(lmp, mat, model, st, int(round(t_average / dt)))
+        stats.update({k: v for k, v in state["stats"].items() if "_final_" in k})  # end of the averaging
+    finally:
+        lmp.close()
+    x = state["x"]
+    volume = float((mat.rho * dx**3 / state["rho"]).sum())
+    z_c = float(x[:, 2].mean())
+    height = float(x[:, 2].max()) + dx / 2
+    theta_c = cap_angle_from_centroid(volume, z_c)
+    theta_s, sphere_r = cap_angle_from_surface(x, dx)
+    # base radius of the cap with this volume and height: V = pi H (3 a^2 + H^2) / 6
+    a2 = (6 * volume / (math.pi * height) - height**2) / 3
+    base = math.sqrt(max(a2, 0.0))
+    return {
+        "wetting_ratio": wetting_ratio,
+        "angle_deg": theta_s,
+        "sphere_radius_m": sphere_r,
+        "angle_centroid_deg": theta_c,
+        "angle_height_deg": math.degrees(2 * math.atan2(height, base)),
+        "height_m": height,
+        "base_radius_m": base,
+        "volume_m3": volume,
+        "n_liquid": len(x),
+        "n_liquid_initial": n_initial,
+        "dt_s": dt,
+        "s_ll_N": model.s_ll,
+        "x_liquid_m": x,
+        **stats,
+    }
+
+
+def slab_tension(
+    material: str | Material = "Ti-Gr2",
+    strength: float | None = None,
+    layers: int = 12,
+    width_cells: int = 8,
+    t_equil: float = 1.5e-3,
+    t_measure: float = 1.5e-3,
+    settings: SceneSettings | None = None,
+    log: str | None = None,
+) -> dict:
+    """Surface tension of a liquid slab (periodic in x and y, two free surfaces normal to z), virial route.
+
+    sigma = (L_z / 2) * (P_zz - (P_xx + P_yy) / 2), with the pair virial pressure tensor P of the whole box
+    (SPH and cohesive pair forces, no kinetic part) averaged every step over ``t_measure`` after ``t_equil``
+    (Kirkwood and Buff 1949).
+
+    Parameters
+    ----------
+    material : str or Material
+        Material key or object.
+    strength : float, optional
+        s_ll, N; default sized by the calibration for the material's surface tension.
+    layers : int
+        Particle layers of the slab.
+    width_cells : int
+        Periodic box width in particle spacings (must exceed 2 h / dx).
+    t_equil, t_measure : float
+        Equilibration and averaging times, s.
+    settings : SceneSettings, optional
+        Numerical settings.
+    log : str, optional
+        LAMMPS log file.
+
+    Returns
+    -------
+    dict
+        ``sigma_N_m`` (measured), ``sigma_nominal_N_m`` (what the model was sized for), ``c_sigma``
+        (= sigma dx / s), ``s_ll_N``, ``rho_mean_rel`` and the run statistics.
+    """
+    mat = get_material(material) if isinstance(material, str) else material
+    st = settings or SceneSettings()
+    model = _model(mat, st, strength, 1.0)
+    dx = st.dx
+    half_xy = width_cells * dx / 2
+    half_z = layers * dx / 2 + 3 * model.h
+    lmp = new_lammps(log=log)
+    try:
+        _setup(lmp, st, (half_xy, half_xy, half_z), boundary="p p f")
+        lmp.command(f"lattice sc {dx:.6g} origin 0.5 0.5 0.5")
+        lmp.command(f"region slab block INF INF INF INF {-layers * dx / 2:.9g} {layers * dx / 2:.9g} units box")
+        lmp.command(f"create_atoms {LIQUID} region slab")
+        dt = _finish_setup(lmp, mat, model, st)
+        _run_chunks(lmp, int(round(t_equil / dt)), st, mat.rho)
+        n_meas = max(st.chunk, int(round(t_measure / dt)) // st.chunk * st.chunk)
+        lmp.command("compute pvir all pressure NULL virial")
+        lmp.command(f"fix pavg all ave/time 1 {n_meas} {n_meas} c_pvir[1] c_pvir[2] c_pvir[3]")
+        lmp.command("run 0 post no")
+        stats = _run_chunks(lmp, n_meas, st, mat.rho)
+        pxx, pyy, pzz = (lmp.numpy.extract_fix("pavg", 0, 1, nrow=i) for i in range(3))
+        rho = _local(lmp, "rho")
+        rho_mean = float(np.mean(rho) / mat.rho)
+    finally:
+        lmp.close()
+    sigma = 2 * half_z / 2 * (pzz - (pxx + pyy) / 2)
+    return {
+        "sigma_N_m": float(sigma),
+        "sigma_nominal_N_m": model.sigma if strength is None else float("nan"),
+        "c_sigma": float(sigma * dx / model.s_ll),
+        "s_ll_N": model.s_ll,
+        "rho_mean_rel": rho_mean,
+        "dt_s": dt,
+        **stats,
+    }
+
+
+def _loop_breakdown(log: Path) -> dict:
+    """Pair share of the loop time and average neighbours per atom from the last full run summary in ``log``."""
+    text = log.read_text().splitlines()
+    pair = [ln for ln in text if ln.startswith("Pair    |")]
+    neigh = [ln for ln in text if ln.startswith("Ave neighs/atom")]
+    return {
+        "pair_fraction": float(pair[-1].split("|")[-1]) / 100 if pair else float("nan"),
+        "neighbors_per_particle": float(neigh[-1].split("=")[-1]) if neigh else float("nan"),
+    }
+
+
+def benchmark(
+    material: str | Material = "Ti-Gr2",
+    cells: tuple[int, int, int] = (30, 30, 6),
+    liquid_layers: int = 3,
+    nsteps: int = 200,
+    cohesion_on_solid_pairs: bool = False,
+    settings: SceneSettings | None = None,
+) -> dict:
+    """Throughput of the pair styles in the bead driver's chunked loop, with or without the cohesive term.
+
+    Scene: a frozen plate of ``cells`` particles (type 2) under ``liquid_layers`` liquid layers (type 1), both
+    in ``fix sph``; ``run chunk pre no post no`` repeated, with solid velocity and density reset from Python
+    between chunks (as the driver does). A last plain ``run`` of ``chunk`` steps gives LAMMPS' timing summary.
+
+    Parameters
+    ----------
+    material : str or Material
+        Material key or object.
+    cells : tuple of int
+        Plate size in particles (x, y, z).
+    liquid_layers : int
+        Liquid layers on top of the plate.
+    nsteps : int
+        Timed steps (after one untimed chunk).
+    cohesion_on_solid_pairs : bool
+        Give all type pairs the cohesive sub-style (liquid-liquid strength), so it uses the full neighbour
+        list instead of a type-filtered one (to measure what the filtering saves).
+    settings : SceneSettings, optional
+        Numerical settings; ``backend`` ("none", "table", "lepton") and ``skin`` are the things to vary.
+
+    Returns
+    -------
+    dict
+        The statistics of the timed chunked loop (``particle_steps_per_s``, ``particles``, ``wall_s``, ...),
+        ``pair_fraction`` (share of loop time in pair styles) and ``neighbors_per_particle`` (master list).
+    """
+    mat = get_material(material) if isinstance(material, str) else material
+    st = settings or SceneSettings()
+    model = _model(mat, st, None, 1.0)
+    dx = st.dx
+    nx, ny, nz = cells
+    tmp = tempfile.TemporaryDirectory()
+    log = Path(tmp.name) / "benchmark.log"
+    lmp = new_lammps(log=log)
+    try:
+        _setup(lmp, st, (nx * dx / 2, ny * dx / 2, (nz + liquid_layers + 4) * dx), boundary="p p f")
+        lmp.command(f"lattice sc {dx:.6g} origin 0.5 0.5 0.5")
+        lmp.command(f"region plate block INF INF INF INF {-nz * dx:.9g} 0 units box")
+        lmp.command(f"region pool block INF INF INF INF 0 {liquid_layers * dx:.9g} units box")
+        lmp.command(f"create_atoms {SOLID} region plate")
+        lmp.command(f"create_atoms {LIQUID} region pool")
+        _finish_setup(lmp, mat, model, st, (LIQUID, SOLID) if cohesion_on_solid_pairs else (LIQUID,))
+        _run_chunks(lmp, st.chunk, st, mat.rho)
+        stats = _run_chunks(lmp, nsteps, st, mat.rho)
+        lmp.command(f"run {nsteps} post yes")
+    finally:
+        lmp.close()
+    breakdown = _loop_breakdown(log)
+    tmp.cleanup()
+    return {**stats, **breakdown}
+
+
+def calibrate(
+    material: str | Material = "Ti-Gr2",
+    strength_factors: tuple[float, ...] = (0.7, 1.0, 1.4),
+    settings: SceneSettings | None = None,
+) -> dict:
+    """Measure C_sigma = sigma dx / s with :func:`slab_tension` at several strengths around the nominal one.
+
+    Parameters
+    ----------
+    material : str or Material
+        Material key or object.
+    strength_factors : tuple of float
+        Multiples of the nominal s_ll (from the current :data:`beadsim.sph.tension.SIGMA_CALIBRATION`).
+    settings : SceneSettings, optional
+        Numerical settings (dx above all).
+
+    Returns
+    -------
+    dict
+        ``c_sigma`` (mean), ``c_sigma_std`` (spread over strengths), ``runs`` (each run's result).
+    """
+    mat = get_material(material) if isinstance(material, str) else material
+    st = settings or SceneSettings()
+    s0 = _model(mat, st, None, 1.0).s_ll
+    runs = [slab_tension(mat, strength=f * s0, settings=st) for f in strength_factors]
+    c = np.array([r["c_sigma"] for r in runs])
+    return {"c_sigma": float(c.mean()), "c_sigma_std": float(c.std()), "runs": runs}
