@@ -44,3 +44,20 @@ def test_leave_one_out_never_fits_a_mode_to_itself(tmp_path, experiments):
     assert (loo["width_err_rel_loo"] ** 2).sum() >= (loo["width_err_rel_fit"] ** 2).sum() - 1e-12
     # Width grows with absorbed power, so the calibrated efficiency is where mode 1's width is matched best.
     assert summary["width_rms_err_rel_loo"] < 0.5
+
+
+def test_stability_classes():
+    from beadsim.analysis import stability_class
+
+    assert stability_class("failed", np.nan, np.nan, np.nan) == "blown_up"
+    assert stability_class("ok", 0.98, 1.03, 0.01) == "stable"
+    assert stability_class("ok", 0.90, 1.03, 0.01) == "degraded"
+    assert stability_class("ok", 0.98, 1.03, 0.08) == "degraded"
+
+
+def test_pareto_front():
+    from beadsim.analysis import pareto_front
+
+    cost = np.array([1.0, 2.0, 3.0, 2.5, 10.0, np.nan])
+    err = np.array([0.5, 0.2, 0.25, 0.1, 0.1, 0.0])
+    assert list(pareto_front(cost, err)) == [True, True, False, True, False, False]

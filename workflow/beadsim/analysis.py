@@ -177,3 +177,30 @@ def convergence_table(ds: xr.Dataset, parameter: str = "resolution_mm",
                 row["finest"] = float(vals[0])
             rows.append(row)
     return pd.DataFrame(rows)
+
+
+# Stability classes of a run, from the watchdog's verdict and the quality of a run that held.
+STABILITY_CLASSES = ("stable", "degraded", "blown_up")
+
+
+def stability_class(status: str, density_min: float, density_max: float, energy_error: float,
+                    density_band: float = 0.05, energy_band: float = 0.02) -> str:
+    """Classify one run: ``blown_up`` (the watchdog stopped it), ``degraded`` (it held, but the liquid density
+    left rho0 +- density_band or the energy balance is off by more than energy_band), ``stable`` otherwise."""
+    if status != "ok":
+        return "blown_up"
+    dens_ok = (not np.isfinite(density_min) or density_min >= 1 - density_band) and \
+        (not np.isfinite(density_max) or density_max <= 1 + density_band)
+    energy_ok = not np.isfinite(energy_error) or abs(energy_error) <= energy_band
+    return "stable" if dens_ok and energy_ok else "degraded"
+
+
+def pareto_front(cost: np.ndarray, error: np.ndarray) -> np.ndarray:
+    """Boolean mask of the points no other point beats in both cost and error (lower is better)."""
+    cost, error = np.asarray(cost, float), np.asarray(error, float)
+    ok = np.isfinite(cost) & np.isfinite(error)
+    front = np.zeros(len(cost), bool)
+    for i in np.where(ok)[0]:
+        dominated = ok & (cost <= cost[i]) & (error <= error[i]) & ((cost < cost[i]) | (error < error[i]))
+        front[i] = not dominated.any()
+    return front
