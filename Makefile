@@ -19,7 +19,7 @@ endif
 PROFILE := --workflow-profile workflow/profiles/workstation
 SNAKEMAKE := $(BIN)/snakemake --configfile $(CONFIG) $(PROFILE) --cores $(CORES)
 
-.PHONY: env run report test lint schema bench clean
+.PHONY: env run report test test-cluster lint schema bench clean
 
 env: $(STAMP)
 
@@ -39,7 +39,14 @@ report: env
 	@echo "report: $(REPORT)"
 
 test: env
-	$(BIN)/python -m pytest -q $(PYTEST_ARGS)
+	$(BIN)/python -m pytest -q -m "not cluster" $(PYTEST_ARGS)
+
+# Starts a single-node SLURM on this machine (root; installs slurm-wlm, munge, slurmdbd, mariadb once), runs the
+# tiny study through workflow/profiles/slurm (tests/cluster), stops SLURM.
+test-cluster: env
+	$(BIN)/pip install --quiet -r envs/requirements-cluster.txt -c envs/constraints.txt
+	bash .ci/slurm/start.sh && BEADSIM_SLURM=1 $(BIN)/python -m pytest -q tests/cluster $(PYTEST_ARGS); \
+	rc=$$?; bash .ci/slurm/stop.sh; exit $$rc
 
 lint: env
 	$(BIN)/snakemake --lint --configfile $(CONFIG)

@@ -24,8 +24,8 @@ log = logging.getLogger("beadsim.runner")
 def run_model(params: dict, outdir: Path, materials_file=None, tasks: int = 1, mpi: str = "mpirun") -> dict:
     """Dispatch to the model named by ``params['model']``; return its metrics.
 
-    SPH runs with ``tasks > 1`` are launched as ``<mpi> -n <tasks> python -m beadsim.sph.mpi_main``; the
-    reduced model always runs in this process.
+    SPH runs with ``tasks > 1`` are launched as ``<mpi> -n <tasks> python -m beadsim.sph.mpi_main`` (``mpi``
+    may hold options, e.g. "srun --mpi=pmi2"); the reduced model always runs in this process.
     """
     material = get_material(params["material"], materials_file)
     if params["model"] == "reduced":

@@ -106,6 +106,17 @@ def build_schema() -> dict:
                 },
                 },
             },
+            "execution": {
+                "type": "object",
+                "additionalProperties": False,
+                "description": "how runs execute; set by profiles or --config, not by study files",
+                "properties": {
+                    "sph_tasks": {"type": ["integer", "string"], "pattern": "^[1-9][0-9]*$", "minimum": 1,
+                                  "default": 1, "description": "MPI ranks per SPH run"},
+                    "mpi": {"type": "string", "default": "mpirun",
+                            "description": "launcher of the ranks: mpirun (workstation), srun (SLURM), ..."},
+                },
+            },
             "analysis": {
                 "type": "object",
                 "additionalProperties": False,

@@ -21,6 +21,8 @@ MATERIALS_FILE = in_root(config.get("materials_file", "config/materials.yaml"))
 DESIGN = design(config, load_experiments(EXPERIMENTS_FILE))
 RUN_IDS = list(DESIGN.index)
 OUT = f"results/{STUDY}"
+# Execution settings come from the profile (config: [...]) or --config, never from a study file.
+EXECUTION = {"sph_tasks": 1, "mpi": "mpirun", **config.get("execution", {})}
 
 
 wildcard_constraints:
@@ -30,6 +32,16 @@ wildcard_constraints:
 def get_case(wildcards):
     """Resolved parameters of one run (a change re-runs it)."""
     return case_params(DESIGN, wildcards.run_id)
+
+
+def get_tasks(wildcards):
+    """MPI ranks of one run: execution.sph_tasks for SPH runs, 1 for the reduced model."""
+    return int(EXECUTION["sph_tasks"]) if get_case(wildcards)["model"] == "sph" else 1
+
+
+def get_mpi(wildcards):
+    """The rank launcher, or "" for single-process runs (the SLURM plugin refuses MPI jobs with one task)."""
+    return EXECUTION["mpi"] if get_tasks(wildcards) > 1 else ""
 
 
 def get_results(wildcards=None):

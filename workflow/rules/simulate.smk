@@ -10,10 +10,10 @@ rule simulate_bead:
         f"logs/{STUDY}/simulate_bead/{{run_id}}.log",
     benchmark:
         f"benchmarks/{STUDY}/simulate_bead/{{run_id}}.tsv"
-    threads: 1
+    threads: get_tasks
     resources:
-        # MPI ranks for one SPH run and the launcher (profiles set them: mpirun on a workstation, srun on SLURM).
-        tasks=1,
-        mpi="mpirun",
+        # MPI ranks of the run and their launcher (execution.sph_tasks / execution.mpi, set by the profile).
+        tasks=get_tasks,
+        mpi=get_mpi,
     script:
         "../scripts/simulate_bead.py"
