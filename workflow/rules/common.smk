@@ -59,6 +59,8 @@ def get_final_output():
         extra += [f"{OUT}/calibration/leave_one_out.csv", f"{OUT}/calibration/curves.png"]
     if "convergence" in analyses:
         extra += [f"{OUT}/convergence/richardson.csv", f"{OUT}/convergence/convergence.png"]
+    sph_runs = [r for r in RUN_IDS if DESIGN.loc[r, "model"] == "sph"]
+    extra += expand(f"{OUT}/runs/{{run_id}}/bead.png", run_id=sph_runs)
     return extra + [
         f"{OUT}/dataset.nc",
         f"{OUT}/summary.csv",

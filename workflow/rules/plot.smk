@@ -16,3 +16,25 @@ rule plot_process_maps:
         f"logs/{STUDY}/plot_process_maps.log",
     script:
         "../scripts/plot_process_maps.py"
+
+
+rule draw_bead:
+    input:
+        f"{OUT}/runs/{{run_id}}/result.json",
+    output:
+        report(
+            f"{OUT}/runs/{{run_id}}/bead.png",
+            caption="../report/bead.rst",
+            category="SPH runs",
+            subcategory="{run_id}",
+            labels={"run": "{run_id}", "figure": "temperature sections"},
+        ),
+    params:
+        case=get_case,
+        materials=MATERIALS_FILE,
+    conda:
+        "../../envs/beadsim.yaml"
+    log:
+        f"logs/{STUDY}/draw_bead/{{run_id}}.log",
+    script:
+        "../scripts/draw_bead.py"

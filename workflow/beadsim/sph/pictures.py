@@ -128,3 +128,17 @@ def latest_dump(folder: str | Path) -> Path | None:
 
     dumps = sorted(Path(folder).glob("*.lammpstrj"), key=step)
     return dumps[-1] if dumps else None
+
+
+def run_picture(run_dir: str | Path, dx: float, T_melt: float, result: dict) -> plt.Figure:
+    """Pictures of a run folder's last dump, titled with its status; a note figure if it has no dump."""
+    dump = latest_dump(Path(run_dir) / "dumps")
+    status = result.get("status", "?")
+    note = f"{result.get('run_id', '')}: {status}" + (f" ({result['reason']})" if result.get("reason") else "")
+    if dump is None:
+        fig, ax = plt.subplots(figsize=(6, 1.5))
+        ax.text(0.5, 0.5, f"{note}\nno particle dump was written", ha="center", va="center")
+        ax.axis("off")
+        return fig
+    snap = read_dump(dump)
+    return bead_pictures(snap, dx, T_melt, title=f"{note}; step {snap['timestep']}; white: T = {T_melt:g} K")

@@ -1,0 +1,119 @@
+"""SPH bead driver against conservation laws, with real LAMMPS on tiny scenes.
+
+Scene: titanium, dx 0.4 mm, a 14 x 5.6 x 2.4 mm block (~3200 particles), beam 1000 W x 0.85 on a ring of D 1.2 mm,
+V_s 10 mm/s, V_w 20 mm/s, wire 1.2 mm, 0.8 s of process (8 mm of travel, ~16k steps, ~45 s on one core).
+Run them with
+
+    /tmp/venv/bin/pytest tests/sph -v
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from beadsim.errors import SimulationFailed
+from beadsim.parameters import defaults
+from beadsim.sph.driver import run_case
+
+# mass balance: net added cross-section behind the pool / wire area x V_w / V_s. The window is short (1-2 mm,
+# 3-5 particle columns) and close to the start of the track at this resolution, so the tolerance is wide
+# (measured 0.95; 0.87-1.24 over the option variants at 0.6 s).
+MASS_BALANCE_TOL = 0.3
+# energy: beam energy in = internal + kinetic + potential change + evaporated + boundary loss (- wire inflow).
+ENERGY_BALANCE_TOL = 1e-3
+
+
+def small_case(**overrides) -> dict:
+    """Parameters of the small test bead."""
+    p = defaults()
+    p.update(model="sph", resolution_mm=0.4, sim_time_s=0.8, domain_margin_mm=1.5, domain_depth_mm=2.4,
+             beam_power_W=1000.0, substrate_speed_mm_s=10.0, wire_feed_mm_s=20.0, scan_diameter_mm=1.2,
+             beam_spot_radius_mm=0.2, wire_length_mm=1.2, dump_interval_s=0.1)
+    p.update(overrides)
+    return p
+
+
+@pytest.fixture(scope="module")
+def small_bead(tmp_path_factory):
+    """Run the small bead once; return (params, metrics, outdir)."""
+    out = tmp_path_factory.mktemp("bead")
+    params = small_case()
+    return params, run_case(params, out), out
+
+
+def test_small_bead_mass_balance(small_bead):
+    params, m, _ = small_bead
+    supply = math.pi * (params["wire_diameter_mm"] / 2) ** 2 * params["wire_feed_mm_s"] / params[
+        "substrate_speed_mm_s"]
+    assert m["wire_supply_area_mm2"] == pytest.approx(supply)
+    assert m["simulated_time_s"] == pytest.approx(params["sim_time_s"], rel=1e-3)
+    assert m["mass_balance_ratio"] == pytest.approx(1.0, abs=MASS_BALANCE_TOL)
+    assert 0 < m["bead_area_mm2"] and 0 < m["bead_height_mm"] < 3 * params["wire_diameter_mm"]
+
+
+def test_small_bead_energy_balance(small_bead):
+    params, m, out = small_bead
+    delivered = params["beam_power_W"] * params["beam_efficiency"] * m["simulated_time_s"]
+    assert m["energy_in_J"] == pytest.approx(delivered, rel=1e-6)
+    assert abs(m["energy_balance_error"]) < ENERGY_BALANCE_TOL
+    ts = xr.open_dataset(out / "timeseries.nc")
+    # the ledger recorded in the time series closes at every sample, not only at the end
+    closure = (ts.E_residual / ts.E_beam).where(ts.E_beam > 0)
+    assert float(np.nanmax(np.abs(closure))) < ENERGY_BALANCE_TOL
+    assert (np.diff(ts.E_beam) > 0).all()
+    assert 0 <= m["evaporated_energy_J"] < delivered and 0 < m["boundary_heat_loss_J"] < delivered
+    assert params["preheat_K"] < m["T_max_K"]
+
+
+def test_small_bead_outputs(small_bead):
+    params, m, out = small_bead
+    deck = (out / "deck.in").read_text()
+    assert "pair_style hybrid/overlay sph/taitwater sph/heatconduction" in deck and "run 10" in deck
+    dumps = sorted((out / "dumps").glob("*.lammpstrj"))
+    assert len(dumps) >= 2
+    assert "id type x y z vx vy vz c_rho c_e c_T" in dumps[-1].read_text()[:2000]
+    assert (out / "restart" / "restart.bin").exists() and (out / "restart" / "state.npz").exists()
+    assert 1 - params["density_tolerance"] < m["density_min"] <= m["density_max"] < 1 + params["density_tolerance"]
+
+
+def test_watchdog_catches_large_time_step(tmp_path):
+    params = small_case(dt_factor=8.0, sim_time_s=0.2)
+    with pytest.raises(SimulationFailed) as info:
+        run_case(params, tmp_path)
+    reason = info.value.reason
+    assert "t=" in reason and any(word in reason for word in ("density", "speed", "lost", "non-finite", "energy"))
+    assert info.value.metrics["simulated_time_s"] < params["sim_time_s"]
+    assert (tmp_path / "deck.in").exists()
+
+
+def test_beam_lands_on_the_surface_seen_from_above():
+    """Ring beam on a flat lattice (dx 0.1 mm): exact energy, mean radius R + sigma^2 / R of an annular Gaussian;
+    with a bar 1 mm above the surface, the bar takes the energy of the columns it covers."""
+    from beadsim.lammps_env import new_lammps
+    from beadsim.sph.driver import deposit_beam
+    from beadsim.sph.scene import build_geometry, substrate_positions
+
+    params = small_case(beam_layers=1, resolution_mm=0.1, domain_depth_mm=0.3)
+    geom = build_geometry(params)
+    flat = substrate_positions(geom)
+    bar = flat[(flat[:, 2] > -geom.dx) & (np.abs(flat[:, 1]) < 0.3e-3)] + [0.0, 0.0, 1e-3]
+    lmp = new_lammps()
+    try:
+        e_flat = np.zeros(len(flat))
+        assert deposit_beam(lmp, params, geom, flat, e_flat, 2.0, 0.0, 0.0, 1e-3) == 2.0
+        shadowed = np.vstack([flat, bar])
+        e_shadow = np.zeros(len(shadowed))
+        deposit_beam(lmp, params, geom, shadowed, e_shadow, 2.0, 0.0, 0.0, 1e-3)
+    finally:
+        lmp.close()
+    assert e_flat.sum() == pytest.approx(2.0, rel=1e-12) and e_shadow.sum() == pytest.approx(2.0, rel=1e-12)
+    assert (e_flat[flat[:, 2] < -geom.dx] == 0).all()  # one layer: only the top layer is heated
+    radius, sigma = params["scan_diameter_mm"] / 2 * 1e-3, params["beam_spot_radius_mm"] * 1e-3
+    r_mean = np.average(np.hypot(flat[:, 0], flat[:, 1]), weights=e_flat)
+    assert r_mean == pytest.approx(radius + sigma ** 2 / radius, rel=0.03)
+    under_bar = (np.abs(shadowed[:, 1]) < 0.3e-3) & (shadowed[:, 2] < 0)
+    assert e_shadow[under_bar].sum() == 0 and e_shadow[len(flat):].sum() > 0.1

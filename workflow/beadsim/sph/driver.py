@@ -1,0 +1,998 @@
+"""Chunked embedded-LAMMPS driver of the SPH bead model.
+
+LAMMPS (SPH package, ``units si``) integrates continuity (eq. 10), momentum (eq. 20: Tait pressure, Morris or
+artificial viscosity, gravity) and energy (eq. 21: heat conduction with D = k / (rho cp)) in chunks of
+``chunk_steps`` steps. Between chunks Python does what no LAMMPS command does: it deposits the beam energy on the
+particles seen from above inside the footprint, creates wire slices at the feed end, switches particle types
+between substrate / wire / liquid / resolidified, resets the velocities of frozen particles (to zero, or to the
+feed velocity for wire that never melted), resets the density of frozen particles, applies a Shepard filter to
+the liquid density, caps temperatures at boiling (the excess counted as evaporation), removes heat through the
+cut faces of the block (far-field condition), closes the energy ledger and runs the watchdog.
+
+Energy convention: ``esph`` holds the internal energy of a particle in joules and ``cv`` its heat capacity
+m c_p in J/K, so T = e / cv. This is the convention of ``pair sph/taitwater``, whose pressure work and viscous
+heating are added in joules; ``pair sph/heatconduction`` is linear in e and needs no choice for equal masses.
+
+Outputs in ``outdir``: ``deck.in`` (every LAMMPS command issued, in order; Python-side actions as comments),
+``log.lammps``, ``dumps/dump.<step>.lammpstrj`` (``id type x y z vx vy vz c_rho c_e c_T``, for OVITO),
+``restart/restart.bin`` + ``restart/state.npz`` (checkpoint) and ``timeseries.nc``.
+
+Resume a killed run with ``run_case(params, outdir, resume=True)`` (same params): it reads the last checkpoint,
+re-issues the pair styles, computes and fixes, restores the Python state (energy ledger, wire feed position,
+ever-molten flags, time series) and continues to ``sim_time_s``.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from scipy.spatial import cKDTree
+
+from beadsim.errors import SimulationFailed
+from beadsim.lammps_env import new_lammps
+from beadsim.materials import Material, get_material
+from beadsim.sph import scene
+from beadsim.sph.scene import (TYPE_LIQUID, TYPE_RESOLIDIFIED, TYPE_SUBSTRATE, TYPE_WIRE, SceneGeometry,
+                               build_geometry)
+
+log = logging.getLogger("beadsim.sph")
+
+GRAVITY = 9.81  # m s-2
+DENSITY_MARGIN = 0.01  # allowed hydrostatic density error g H / c0^2 for the automatic sound speed
+
+
+# ----------------------------------------------------------------------------------------------- numerics
+
+@dataclass(frozen=True)
+class Numerics:
+    """Discretisation constants (SI).
+
+    Attributes
+    ----------
+    dx, h : particle spacing and kernel cutoff (m)
+    mass : particle mass rho dx^3 (kg)
+    c0 : sound speed (m/s)
+    dt : time step (s)
+    limits : the individual time-step limits (s) before ``dt_factor``
+    expected_speed : largest melt speed the scene is expected to reach (m/s)
+    tait_rho0 : reference density of the Tait equation (kg/m^3): rho, or lower with surface tension
+    cohesion : the :class:`beadsim.sph.tension.CohesionModel` when surface tension is on, else None
+    """
+
+    dx: float
+    h: float
+    mass: float
+    c0: float
+    dt: float
+    limits: dict
+    expected_speed: float
+    tait_rho0: float
+    cohesion: object = None
+
+
+def choose_numerics(params: dict, mat: Material, geom: SceneGeometry) -> Numerics:
+    """Sound speed and time step from the scene.
+
+    The sound speed is ``sound_speed_m_s`` or, when that is 0, max(10 v_exp, sqrt(g H_liq / 0.01)) with v_exp
+    the largest of V_s, V_w and the free-fall speed from the top of the wire at the beam, and H_liq the block
+    depth (density error of the hydrostatic column below 1 %). The time step is ``dt_factor`` times the
+    smallest of: acoustic 0.1 h / c0 (the stable 2 s recipe, dt 4e-5 s at dx 0.3 mm, h 2.5 dx, c0 2 m/s,
+    sits at 0.107 h / c0; 0.16 h / c0 was measured to be the edge), viscous 0.125 h^2 / nu (eq. 22; with
+    artificial viscosity nu = alpha c0 h / 8), thermal 0.1 dx^2 / D, gravity 0.25 sqrt(h / g) and, with
+    surface tension, the capillary and shifted-acoustic limit of :meth:`tension.CohesionModel.dt_limit`
+    (capillary and shifted-acoustic, factors measured there) and a sound speed raised to keep Laplace pressures
+    small.
+    """
+    dx = params["resolution_mm"] * 1e-3
+    h = params["kernel_cutoff_factor"] * dx
+    fall = math.sqrt(2 * GRAVITY * (geom.wire_height + geom.wire_radius))
+    v_exp = max(geom.substrate_speed, geom.wire_feed, fall)
+    c0 = params["sound_speed_m_s"] or max(10 * v_exp, math.sqrt(GRAVITY * -geom.z_lo / DENSITY_MARGIN))
+    angle = params.get("wetting_angle_deg") or mat.contact_angle_deg
+    cohesion = cohesion_model(mat, dx, h, angle) if params["surface_tension"] else None
+    if cohesion is not None and not params["sound_speed_m_s"]:
+        c0 = max(c0, cohesion.min_sound_speed(mat))
+    nu = mat.nu if params["viscosity_model"] == "morris" else params["artificial_viscosity"] * c0 * h / 8
+    limits = {"acoustic": 0.1 * h / c0, "viscous": 0.125 * h * h / max(nu, 1e-30),
+              "thermal": 0.1 * dx * dx / mat.diffusivity, "gravity": 0.25 * math.sqrt(h / GRAVITY)}
+    tait_rho0 = mat.rho
+    if cohesion is not None:
+        limits["capillary"] = cohesion.dt_limit(mat, dx, c0, params["artificial_viscosity"])
+        if params["viscosity_model"] == "morris" or params["artificial_viscosity"] < 0.2:
+            log.warning("surface tension held in drop tests only with artificial viscosity >= 0.2 (tension.py)")
+        tait_rho0 = cohesion.tait_rho0(mat, c0)
+    dt = params["dt_factor"] * min(limits.values())
+    return Numerics(dx=dx, h=h, mass=mat.rho * dx ** 3, c0=c0, dt=dt, limits=limits, expected_speed=v_exp,
+                    tait_rho0=tait_rho0, cohesion=cohesion)
+
+
+def cohesion_model(mat: Material, dx: float, h: float, angle_deg: float):
+    """Surface-tension model of :mod:`beadsim.sph.tension` for the material's sigma and a contact angle (degree).
+
+    The angle is clamped to the calibrated range of ``tension.CONTACT_ANGLE_TABLE`` (with a warning).
+    """
+    from beadsim.sph import tension
+
+    angles = [a for _, a in tension.CONTACT_ANGLE_TABLE]
+    used = min(max(angle_deg, min(angles)), max(angles))
+    if used != angle_deg:
+        log.warning("contact angle %.0f deg is outside the calibrated %.0f-%.0f deg; using %.0f deg",
+                    angle_deg, min(angles), max(angles), used)
+    return tension.CohesionModel.from_material(mat, dx, h=h, contact_angle_deg=used)
+
+
+# ----------------------------------------------------------------------------------------------- helpers
+
+class Deck:
+    """Issue LAMMPS commands and record each one in ``deck.in``.
+
+    Parameters
+    ----------
+    lmp : lammps.lammps
+    path : pathlib.Path
+        The deck file (appended to, so a resumed run keeps the history).
+    """
+
+    def __init__(self, lmp, path: Path):
+        self.lmp = lmp
+        self.fh = open(path, "a", buffering=1) if is_rank0(lmp) else None
+
+    def __call__(self, line: str) -> None:
+        if self.fh:
+            self.fh.write(line + "\n")
+        self.lmp.command(line)
+
+    def note(self, text: str) -> None:
+        """Record a Python-side action as a comment."""
+        if self.fh:
+            self.fh.write(f"# python: {text}\n")
+
+    def close(self) -> None:
+        if self.fh:
+            self.fh.close()
+
+
+def is_rank0(lmp) -> bool:
+    """True on the MPI rank that writes files (always true on one rank)."""
+    return lmp.extract_setting("world_rank") == 0
+
+
+def allreduce(lmp, value, op: str = "sum"):
+    """Global sum / max / min of a number or array over MPI ranks; a no-op on one rank.
+
+    Parameters
+    ----------
+    lmp : lammps.lammps
+    value : float or numpy.ndarray
+    op : {"sum", "max", "min"}
+    """
+    if lmp.extract_setting("world_size") == 1:
+        return value
+    from mpi4py import MPI  # only needed (and only importable) for multi-rank runs
+
+    mpi_op = {"sum": MPI.SUM, "max": MPI.MAX, "min": MPI.MIN}[op]
+    if isinstance(value, np.ndarray):
+        send = np.ascontiguousarray(value, dtype=float)
+        out = np.empty_like(send)
+        MPI.COMM_WORLD.Allreduce(send, out, op=mpi_op)
+        return out
+    return MPI.COMM_WORLD.allreduce(value, op=mpi_op)
+
+
+def lucy_kernel(r: np.ndarray, h: float) -> np.ndarray:
+    """3-D Lucy kernel W(r, h) (1/m^3), the kernel of the LAMMPS SPH pair styles."""
+    q = np.clip(r / h, 0.0, 1.0)
+    return 105.0 / (16.0 * math.pi * h ** 3) * (1 + 3 * q) * (1 - q) ** 3
+
+
+# ----------------------------------------------------------------------------------------------- beam
+
+def beam_weights(params: dict, cx: np.ndarray, cy: np.ndarray, beam_x: float, t0: float, t1: float) -> np.ndarray:
+    """Unnormalised beam intensity at column centres (cx, cy) (m) for the chunk [t0, t1] (s).
+
+    ring: the time-averaged scanned circle, a Gaussian of sigma ``beam_spot_radius_mm`` across a circle of
+    diameter ``scan_diameter_mm``; gaussian: one spot of that sigma on the axis; scan: the spot moving on the
+    circle at ``scan_frequency_Hz``, averaged over the positions it takes during the chunk (at least 8 samples
+    per chunk and 16 per revolution), so the chunk deposits what the spot swept in it.
+    """
+    sigma = params["beam_spot_radius_mm"] * 1e-3
+    radius = params["scan_diameter_mm"] * 1e-3 / 2
+    dxb, dyb = cx - beam_x, cy
+    profile = params["beam_profile"]
+    if profile == "gaussian":
+        return np.exp(-(dxb ** 2 + dyb ** 2) / (2 * sigma ** 2))
+    if profile == "ring":
+        return np.exp(-(np.hypot(dxb, dyb) - radius) ** 2 / (2 * sigma ** 2))
+    revolutions = params["scan_frequency_Hz"] * (t1 - t0)
+    n = max(8, int(math.ceil(16 * revolutions)))
+    angles = 2 * math.pi * params["scan_frequency_Hz"] * (t0 + (np.arange(n) + 0.5) / n * (t1 - t0))
+    w = np.zeros_like(cx)
+    for a in angles:
+        w += np.exp(-((dxb - radius * math.cos(a)) ** 2 + (dyb - radius * math.sin(a)) ** 2) / (2 * sigma ** 2))
+    return w / n
+
+
+def beam_footprint_radius(params: dict) -> float:
+    """Radius (m) beyond which the beam intensity is neglected: D/2 + 3 sigma."""
+    return params["scan_diameter_mm"] * 1e-3 / 2 + 3 * params["beam_spot_radius_mm"] * 1e-3
+
+
+def deposit_beam(lmp, params: dict, geom: SceneGeometry, x: np.ndarray, esph: np.ndarray, energy: float,
+                 beam_x: float, t0: float, t1: float) -> float:
+    """Add ``energy`` (J) to the surface seen from above inside the beam footprint; return what was added.
+
+    Columns are the dx x dx cells of the substrate lattice in the xy plane. The intensity at each column
+    centre that holds any particle is normalised over those columns; a column's share goes in equal parts to
+    its particles within (beam_layers - 0.5) dx below its topmost particle (substrate, wire or melt alike).
+    """
+    d = geom.dx
+    r_fp = beam_footprint_radius(params)
+    i0 = math.floor((beam_x - r_fp - geom.x_lo) / d)
+    j0 = math.floor((-r_fp - geom.y_lo) / d)
+    n = int(math.ceil(2 * r_fp / d)) + 2
+    ci = np.floor((x[:, 0] - geom.x_lo) / d).astype(np.int64) - i0
+    cj = np.floor((x[:, 1] - geom.y_lo) / d).astype(np.int64) - j0
+    inside = (ci >= 0) & (ci < n) & (cj >= 0) & (cj < n)
+    idx = np.flatnonzero(inside)
+    cell = ci[idx] * n + cj[idx]
+    top = np.full(n * n, -np.inf)
+    np.maximum.at(top, cell, x[idx, 2])
+    top = allreduce(lmp, top, "max")
+    depth = (params["beam_layers"] - 0.5) * d
+    absorb = x[idx, 2] >= top[cell] - depth
+    idx, cell = idx[absorb], cell[absorb]
+    count = allreduce(lmp, np.bincount(cell, minlength=n * n).astype(float), "sum")
+    ii, jj = np.divmod(np.arange(n * n), n)
+    cx = geom.x_lo + (ii + i0 + 0.5) * d
+    cy = geom.y_lo + (jj + j0 + 0.5) * d
+    w = np.where(count > 0, beam_weights(params, cx, cy, beam_x, t0, t1), 0.0)
+    total = w.sum()
+    if total <= 0:
+        return 0.0
+    per_particle = energy * w / total / np.maximum(count, 1)
+    np.add.at(esph, idx, per_particle[cell])
+    return energy
+
+
+# ----------------------------------------------------------------------------------------------- thermo
+
+@dataclass
+class Thermal:
+    """Temperature <-> internal energy of a particle (J), with optional latent heat and boiling cap."""
+
+    mass: float
+    mat: Material
+    latent: bool
+    mushy: float
+
+    @property
+    def heat_capacity(self) -> float:
+        """m c_p of one particle, J/K."""
+        return self.mass * self.mat.cp
+
+    def energy(self, temp: np.ndarray | float) -> np.ndarray | float:
+        """Internal energy (J) of a particle at temperature temp (K)."""
+        e = self.heat_capacity * np.asarray(temp, dtype=float)
+        if self.latent:
+            frac = np.clip((np.asarray(temp) - self.mat.T_melt) / self.mushy, 0.0, 1.0)
+            e = e + self.mass * self.mat.latent_heat * frac
+        return e
+
+    def temperature(self, e: np.ndarray) -> np.ndarray:
+        """Temperature (K) of particles with internal energy e (J)."""
+        c = self.heat_capacity
+        if not self.latent:
+            return e / c
+        tm, lm = self.mat.T_melt, self.mass * self.mat.latent_heat
+        e1, e2 = c * tm, c * (tm + self.mushy) + lm
+        mushy_t = tm + (e - e1) / (c + lm / self.mushy)
+        return np.where(e < e1, e / c, np.where(e > e2, (e - lm) / c, mushy_t))
+
+
+# ----------------------------------------------------------------------------------------------- state
+
+@dataclass
+class Ledger:
+    """Energy bookkeeping (J) since t = 0."""
+
+    beam: float = 0.0
+    volumetric: float = 0.0
+    wire_in: float = 0.0
+    evaporated: float = 0.0
+    boundary: float = 0.0
+    initial: float = 0.0
+
+    def residual(self, now: float) -> float:
+        """Energy present minus what the ledger says should be present (J)."""
+        return now - (self.initial + self.beam + self.volumetric + self.wire_in - self.evaporated - self.boundary)
+
+
+@dataclass
+class RunState:
+    """Everything Python carries between chunks (checkpointed with the restart file)."""
+
+    t: float = 0.0
+    step: int = 0
+    wire_s_last: float = 0.0
+    next_id: int = 1
+    ledger: Ledger = field(default_factory=Ledger)
+    steps_since_shepard: int = 0
+    t_next_restart: float = 0.0
+    steady_time: float = float("nan")
+    rho_min: float = 1.0
+    rho_max: float = 1.0
+    t_max: float = 0.0
+    v_max: float = 0.0
+
+
+class PerId:
+    """Per-particle arrays indexed by global atom id, grown on demand (correct per rank: each rank writes
+    only the ids it owns; reductions go through :func:`allreduce`)."""
+
+    def __init__(self, n: int):
+        self.max_t = np.zeros(n + 1)
+        self.face_area = np.zeros(n + 1)
+
+    def grow(self, n: int) -> None:
+        """Make room for ids up to n."""
+        if n + 1 > len(self.max_t):
+            extra = n + 1 - len(self.max_t)
+            self.max_t = np.concatenate([self.max_t, np.zeros(extra)])
+            self.face_area = np.concatenate([self.face_area, np.zeros(extra)])
+
+
+# ----------------------------------------------------------------------------------------------- driver
+
+class BeadRun:
+    """One SPH bead simulation: scene, LAMMPS setup, chunk loop, watchdog, outputs."""
+
+    def __init__(self, params: dict, outdir: Path, progress=None, material: Material | None = None):
+        self.p = params
+        self.out = Path(outdir)
+        self.progress = progress
+        self.mat = material or get_material(params["material"])
+        self.geom = build_geometry(params)
+        self.num = choose_numerics(params, self.mat, self.geom)
+        self.thermal = Thermal(self.num.mass, self.mat, bool(params["latent_heat"]), params["mushy_range_K"])
+        self.state = RunState()
+        self.series: list[dict] = []
+        self.per_id = PerId(0)
+        self.lammps_time = 0.0
+        self.particle_steps = 0.0
+        self.t_end = params["sim_time_s"]
+        self.chunk = int(params["chunk_steps"])
+        self.t0_wall = time.perf_counter()
+        self.T0 = params["preheat_K"]
+        self.speed_limit = params["speed_limit_m_s"] or 0.5 * self.num.c0
+
+    # ---- setup
+    def open(self, resume: bool) -> None:
+        """Create the LAMMPS instance and the scene (or read the checkpoint)."""
+        for sub in ("dumps", "restart"):
+            (self.out / sub).mkdir(parents=True, exist_ok=True)
+        if not resume:
+            (self.out / "deck.in").unlink(missing_ok=True)
+        self.lmp = new_lammps(log=self.out / ("log.lammps" if not resume else "log.resume.lammps"))
+        self.rank0 = is_rank0(self.lmp)
+        self.deck = Deck(self.lmp, self.out / "deck.in")
+        if resume:
+            self._read_checkpoint()
+        else:
+            self._create_scene()
+        self._define_physics()
+        self._log_numerics()
+
+    def _create_scene(self) -> None:
+        g, d, h = self.geom, self.geom.dx, self.num.h
+        cmd = self.deck
+        cmd("units si")
+        cmd("dimension 3")
+        cmd("atom_style sph")
+        cmd("atom_modify map array")
+        cmd("boundary f f f")
+        cmd("newton on")
+        pad = 2 * h
+        cmd(f"region box block {g.x_lo - pad:.9g} {g.x_hi + pad:.9g} {g.y_lo - pad:.9g} {g.y_hi + pad:.9g} "
+            f"{g.z_lo - pad:.9g} {g.box_z_hi:.9g} units box")
+        cmd(f"create_box {scene.N_TYPES} box")
+        cmd(f"lattice sc {d:.9g} origin 0.5 0.5 0.5")
+        cmd(f"region substrate block {g.x_lo:.9g} {g.x_hi:.9g} {g.y_lo:.9g} {g.y_hi:.9g} {g.z_lo:.9g} 0 "
+            "units box")
+        cmd(f"create_atoms {TYPE_SUBSTRATE} region substrate")
+        cmd(f"mass * {self.num.mass:.9g}")
+        n_sub = int(self.lmp.get_natoms())
+        expected = int(np.prod(g.counts()))
+        if n_sub != expected:
+            raise SimulationFailed(f"substrate lattice has {n_sub} particles, expected {expected}")
+        cmd(f"set type {TYPE_SUBSTRATE} sph/rho {self.mat.rho:.9g}")
+        cmd(f"set type {TYPE_SUBSTRATE} sph/cv {self.thermal.heat_capacity:.9g}")
+        cmd(f"set type {TYPE_SUBSTRATE} sph/e {self.thermal.energy(self.T0):.9g}")
+        self.state.next_id = n_sub + 1
+        wire, s_last = scene.initial_wire(g)
+        self.state.wire_s_last = s_last
+        self._create_wire_atoms(wire)
+        self.per_id.grow(self.state.next_id)
+        ids, x = self._ids(), self._x()
+        self.per_id.face_area[ids] = scene.face_areas(g, x) * (self._types() == TYPE_SUBSTRATE)
+        self.per_id.face_area = allreduce(self.lmp, self.per_id.face_area, "max")  # every rank knows every id
+        self.per_id.max_t[:] = self.T0
+
+    def _create_wire_atoms(self, pos: np.ndarray) -> None:
+        """Create wire particles at pos (m) moving at the feed velocity, at the preheat temperature."""
+        if len(pos) == 0:
+            return
+        first = self.state.next_id
+        for x, y, z in pos:
+            self.deck(f"create_atoms {TYPE_WIRE} single {x:.9g} {y:.9g} {z:.9g} units box")
+        last = first + len(pos) - 1
+        v = self.geom.wire_velocity
+        e0 = self.thermal.energy(self.T0)
+        self.deck(f"set atom {first}*{last} sph/rho {self.mat.rho:.9g} sph/cv {self.thermal.heat_capacity:.9g} "
+                  f"sph/e {e0:.9g} vx {v[0]:.9g} vy {v[1]:.9g} vz {v[2]:.9g}")
+        self.state.next_id = last + 1
+        self.per_id.grow(last)
+        self.per_id.max_t[first:last + 1] = self.T0
+        m = self.num.mass
+        self.state.ledger.wire_in += len(pos) * (e0 + 0.5 * m * float(v @ v)) + m * GRAVITY * float(pos[:, 2].sum())
+
+    def _pair_setup(self) -> tuple[list[str], list[str]]:
+        """Pair sub-styles and pair_coeff lines; surface tension plugs in as one more overlay sub-style."""
+        rho0, c0, h = self.num.tait_rho0, self.num.c0, self.num.h
+        if self.p["viscosity_model"] == "morris":
+            styles = ["sph/taitwater/morris"]
+            coeffs = [f"pair_coeff * * sph/taitwater/morris {rho0:.9g} {c0:.9g} {self.mat.mu:.9g} {h:.9g}"]
+        else:
+            styles = ["sph/taitwater"]
+            coeffs = [f"pair_coeff * * sph/taitwater {rho0:.9g} {c0:.9g} {self.p['artificial_viscosity']:.9g} "
+                      f"{h:.9g}"]
+        styles.append("sph/heatconduction")
+        coeffs.append(f"pair_coeff * * sph/heatconduction {self.mat.diffusivity:.9g} {h:.9g}")
+        model = self.num.cohesion
+        if model is not None:  # surface tension: one more overlay sub-style, liquid-liquid and liquid-solid
+            styles.append(model.pair_style_tokens())
+            coeffs += model.pair_coeff_commands([TYPE_LIQUID], [TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED],
+                                                table_file=self.out / "tension.table")
+        return styles, coeffs
+
+    def _define_physics(self) -> None:
+        cmd, p = self.deck, self.p
+        styles, coeffs = self._pair_setup()
+        cmd("pair_style hybrid/overlay " + " ".join(styles))
+        for line in coeffs:
+            cmd(line)
+        cmd(f"neighbor {0.2 * self.num.dx:.9g} bin")
+        cmd("neigh_modify every 1 delay 0 check yes")
+        cmd("comm_modify vel yes")
+        cmd("compute rho all sph/rho/atom")
+        cmd("compute e all sph/e/atom")
+        cmd("compute T all sph/t/atom")
+        if self.num.cohesion is None:
+            cmd(f"variable frozen atom c_T<{self.mat.T_melt:.9g}")
+        else:  # cohesion acts by type: melt and freeze at chunk ends, when the types switch
+            cmd(f"variable frozen atom type!={TYPE_LIQUID}")
+        cmd("group frozen dynamic all var frozen every 1")
+        cmd("fix integrate all sph")
+        cmd(f"fix gravity all gravity {GRAVITY} vector 0 0 -1")
+        cmd("fix freeze frozen setforce 0.0 0.0 0.0")
+        cmd(f"timestep {self.num.dt:.9g}")
+        if self.num.cohesion is not None:
+            cmd(f"compute cohesion all pair {self.num.cohesion.pair_style_tokens().split()[0]}")
+            cmd("thermo_style custom step time atoms c_cohesion")
+        else:
+            cmd("thermo_style custom step time atoms")
+        cmd("thermo 0")
+        cmd("thermo_modify lost warn norm no")
+        every = max(1, int(round(p["dump_interval_s"] / self.num.dt)))
+        cmd(f"dump snap all custom {every} {self.out / 'dumps'}/dump.*.lammpstrj "
+            "id type x y z vx vy vz c_rho c_e c_T")
+        cmd("dump_modify snap sort id")
+
+    def _log_numerics(self) -> None:
+        n = self.num
+        lim = ", ".join(f"{k} {v:.3g} s" for k, v in n.limits.items())
+        msg = (f"dx {n.dx * 1e3:.3g} mm, h {n.h * 1e3:.3g} mm, c0 {n.c0:.3g} m/s (expected melt speed "
+               f"{n.expected_speed:.3g} m/s), limits: {lim}; dt = {self.p['dt_factor']:.3g} x min = {n.dt:.3g} s; "
+               f"block {self.geom.x_hi - self.geom.x_lo:.4g} x {self.geom.y_hi - self.geom.y_lo:.4g} x "
+               f"{-self.geom.z_lo:.4g} m, cut faces {self.geom.cut_faces}, {self.lmp.get_natoms()} particles")
+        n_slice = scene.wire_slice_count(self.geom)
+        nominal = math.pi * self.geom.wire_radius ** 2
+        msg += (f"; wire slice {n_slice} particles = {n_slice * n.dx ** 2 * 1e6:.3g} mm2 for a nominal "
+                f"{nominal * 1e6:.3g} mm2, slices {scene.wire_slice_pitch(self.geom) * 1e3:.3g} mm apart")
+        log.info(msg)
+        self.deck.note(msg)
+        if self.p["beam_profile"] == "scan":
+            rev = self.p["scan_frequency_Hz"] * self.chunk * n.dt
+            log.info("scan: one chunk spans %.3g beam revolutions; its energy is spread over the arc swept", rev)
+
+    # ---- per-atom views (local to this rank)
+    def _nlocal(self) -> int:
+        return self.lmp.extract_setting("nlocal")
+
+    def _x(self) -> np.ndarray:
+        return self.lmp.numpy.extract_atom("x", nelem=self._nlocal(), dim=3)
+
+    def _v(self) -> np.ndarray:
+        return self.lmp.numpy.extract_atom("v", nelem=self._nlocal(), dim=3)
+
+    def _e(self) -> np.ndarray:
+        return self.lmp.numpy.extract_atom("esph", nelem=self._nlocal())
+
+    def _rho(self) -> np.ndarray:
+        return self.lmp.numpy.extract_atom("rho", nelem=self._nlocal())
+
+    def _cv(self) -> np.ndarray:
+        return self.lmp.numpy.extract_atom("cv", nelem=self._nlocal())
+
+    def _ids(self) -> np.ndarray:
+        return self.lmp.numpy.extract_atom("id", nelem=self._nlocal())
+
+    def _types(self) -> np.ndarray:
+        return self.lmp.numpy.extract_atom("type", nelem=self._nlocal())
+
+    # ---- between chunks
+    def _feed_wire(self) -> bool:
+        """Advance the wire feed end; create the slices that entered. True if atoms were created."""
+        g, st = self.geom, self.state
+        st.wire_s_last -= g.wire_feed * self.chunk * self.num.dt
+        created = False
+        pitch = scene.wire_slice_pitch(g)
+        while st.wire_s_last + pitch <= g.wire_length:
+            st.wire_s_last += pitch
+            # the slice enters at the feed end of the wire as it is at the start of the next chunk
+            pos = scene.wire_slice(g, st.wire_s_last, g.beam_x(st.t))
+            self._create_wire_atoms(pos)
+            created = True
+        return created
+
+    def _phase_update(self) -> tuple[np.ndarray, bool]:
+        """Temperatures, types, frozen velocities and densities after a chunk.
+
+        Returns T (K) and whether any particle changed type (on any rank).
+        """
+        e, v, ids, types, cv = self._e(), self._v(), self._ids(), self._types(), self._cv()
+        if self.thermal.latent:
+            temp = self.thermal.temperature(e)
+            cv[:] = e / np.maximum(temp, 1e-9)
+        else:
+            temp = e / cv
+        self.per_id.max_t[ids] = np.maximum(self.per_id.max_t[ids], temp)
+        liquid = temp >= self.mat.T_melt
+        melted = self.per_id.max_t[ids] >= self.mat.T_melt
+        wire = types == TYPE_WIRE
+        new_types = np.where(liquid, TYPE_LIQUID, np.where(melted, TYPE_RESOLIDIFIED,
+                                                           np.where(wire, TYPE_WIRE, TYPE_SUBSTRATE)))
+        changed = allreduce(self.lmp, int((new_types != types).sum())) > 0
+        types[:] = new_types
+        frozen = ~liquid
+        target = np.where(types[frozen, None] == TYPE_WIRE, self.geom.wire_velocity, 0.0)
+        # kinetic energy removed by freezing a particle in place becomes heat of that particle
+        ke_old = 0.5 * self.num.mass * np.einsum("ij,ij->i", v[frozen], v[frozen])
+        ke_new = 0.5 * self.num.mass * np.einsum("ij,ij->i", target, target)
+        e[frozen] += ke_old - ke_new
+        v[frozen] = target
+        if self.p["solid_density_reset"]:
+            self._rho()[frozen] = self.mat.rho
+        return temp, changed
+
+    def _shepard(self, liquid: np.ndarray) -> None:
+        """Shepard-normalised density of the liquid particles: rho_i = sum m W / sum (m / rho_j) W."""
+        if not liquid.any():
+            return
+        nall = self._nlocal() + self.lmp.extract_setting("nghost")
+        x = self.lmp.numpy.extract_atom("x", nelem=nall, dim=3)
+        rho_all = self.lmp.numpy.extract_atom("rho", nelem=nall)
+        idx = np.flatnonzero(liquid)
+        pairs = cKDTree(x[idx]).sparse_distance_matrix(cKDTree(x), self.num.h, output_type="coo_matrix")
+        other = pairs.col != idx[pairs.row]  # the particle itself is added below, listed or not
+        row, col = pairs.row[other], pairs.col[other]
+        w = lucy_kernel(pairs.data[other], self.num.h)
+        w0 = lucy_kernel(np.zeros(1), self.num.h)[0]
+        num = np.bincount(row, weights=w, minlength=len(idx)) + w0
+        den = np.bincount(row, weights=w / rho_all[col], minlength=len(idx)) + w0 / rho_all[idx]
+        rho_all[idx] = num / den
+
+    def _volumetric_heat(self, dt_chunk: float) -> None:
+        """Add the block's share (block volume / plate volume) of ``volumetric_heat_W`` evenly to every
+        particle that is not unmelted wire."""
+        power = self.p["volumetric_heat_W"]
+        if power <= 0:
+            return
+        g = self.geom
+        plate = (self.p["substrate_length_mm"] * self.p["substrate_width_mm"] * self.p["substrate_thickness_mm"]
+                 * 1e-9)
+        share = min(1.0, (g.x_hi - g.x_lo) * (g.y_hi - g.y_lo) * -g.z_lo / plate)
+        target = self._types() != TYPE_WIRE
+        n = allreduce(self.lmp, int(target.sum()))
+        energy = power * share * dt_chunk
+        self._e()[target] += energy / max(n, 1)
+        self.state.ledger.volumetric += energy if n else 0.0
+
+    def _cap_temperature(self) -> None:
+        if not self.p["temperature_cap"]:
+            return
+        e = self._e()
+        e_cap = self.thermal.energy(self.mat.T_boil)
+        over = e > e_cap
+        excess = float((e[over] - e_cap).sum())
+        e[over] = e_cap
+        self.state.ledger.evaporated += allreduce(self.lmp, excess)  # collective: called on every rank
+
+    def _boundary_flux(self, temp: np.ndarray, dt_chunk: float) -> None:
+        """Heat leaving through the cut faces during the last chunk (far-field or fixed condition)."""
+        mode = self.p["thermal_boundary"]
+        if mode == "insulated" or not self.geom.cut_faces:
+            return
+        ids, e = self._ids(), self._e()
+        area = self.per_id.face_area[ids]
+        on_face = area > 0
+        e0 = self.thermal.energy(self.T0)
+        if mode == "fixed":
+            removed = e[on_face] - e0
+        else:
+            t_eff = max(self.state.t, dt_chunk)
+            length = math.sqrt(math.pi * self.mat.diffusivity * t_eff)
+            flux = self.mat.k * (temp[on_face] - self.T0) / length * area[on_face] * dt_chunk
+            removed = np.minimum(flux, e[on_face] - e0)  # never below the far-field temperature
+        e[on_face] -= removed
+        self.state.ledger.boundary += allreduce(self.lmp, float(removed.sum()))
+
+    def _energy_now(self) -> dict:
+        e, v, x = self._e(), self._v(), self._x()
+        m = self.num.mass
+        parts = {"E_internal": float(e.sum()),
+                 "E_kinetic": float(0.5 * m * np.einsum("ij,ij->", v, v)),
+                 "E_potential": float(m * GRAVITY * x[:, 2].sum())}
+        out = {k: allreduce(self.lmp, val) for k, val in parts.items()}
+        if self.num.cohesion is not None:
+            # global already; tallied at the last step of each chunk (thermo); at t = 0 nothing is liquid
+            out["E_cohesion"] = float(self.lmp.extract_compute("cohesion", 0, 0)) if self.state.step else 0.0
+        return out
+
+    # ---- watchdog
+    def _measure(self, temp: np.ndarray) -> dict:
+        """Global diagnostics after a chunk."""
+        st, lmp = self.state, self.lmp
+        liquid = self._types() == TYPE_LIQUID
+        rho = self._rho() / self.mat.rho
+        speed = np.sqrt(np.einsum("ij,ij->i", self._v(), self._v()))
+        finite = bool(np.isfinite(self._x()).all() and np.isfinite(self._e()).all() and np.isfinite(speed).all())
+        m = {"t": st.t, "step": st.step,
+             "T_max": allreduce(lmp, float(temp.max()), "max"),
+             "n_liquid": allreduce(lmp, int(liquid.sum())),
+             "n_atoms": int(lmp.get_natoms()),
+             "rho_min": allreduce(lmp, float(rho[liquid].min()) if liquid.any() else 1.0, "min"),
+             "rho_max": allreduce(lmp, float(rho[liquid].max()) if liquid.any() else 1.0, "max"),
+             "v_max": allreduce(lmp, float(speed[liquid].max()) if liquid.any() else 0.0, "max"),
+             "finite": allreduce(lmp, int(not finite)) == 0}
+        m.update(self._energy_now())
+        led = st.ledger
+        m.update(E_beam=led.beam, E_volumetric=led.volumetric, E_wire_in=led.wire_in,
+                 E_evaporated=led.evaporated, E_boundary=led.boundary)
+        now = m["E_internal"] + m["E_kinetic"] + m["E_potential"] + m.get("E_cohesion", 0.0)
+        m["E_residual"] = led.residual(now)
+        e_in = led.beam + led.volumetric
+        m["energy_error"] = m["E_residual"] / e_in if e_in > 0 else 0.0
+        xl = self._x()[liquid, 0]
+        m["pool_x_min"] = allreduce(lmp, float(xl.min()) if liquid.any() else np.inf, "min")
+        m["pool_x_max"] = allreduce(lmp, float(xl.max()) if liquid.any() else -np.inf, "max")
+        zw = self._x()[self._types() == TYPE_WIRE, 2]
+        m["wire_z_min"] = allreduce(lmp, float(zw.min()) if len(zw) else np.inf, "min")
+        return m
+
+    def _watchdog(self, m: dict, expected_atoms: int) -> None:
+        tol = self.p["density_tolerance"]
+        where = f"at t={m['t']:.4g} s (step {m['step']})"
+        reason = None
+        if not m["finite"]:
+            reason = f"non-finite position, velocity or energy {where}"
+        elif m["n_atoms"] != expected_atoms:
+            reason = f"{expected_atoms - m['n_atoms']} particles lost (left the box) {where}"
+        elif m["wire_z_min"] < -2 * self.geom.dx:
+            reason = (f"solid wire reached {-m['wire_z_min'] * 1e3:.2f} mm below the surface {where}: the beam "
+                      "does not melt the wire as fast as it is fed (stubbing)")
+        elif m["rho_min"] < 1 - tol or m["rho_max"] > 1 + tol:
+            reason = (f"liquid density {m['rho_min']:.3f}-{m['rho_max']:.3f} rho0 outside 1 +- {tol:g} {where}")
+        elif m["v_max"] > self.speed_limit:
+            reason = f"melt speed {m['v_max']:.3g} m/s above the limit {self.speed_limit:.3g} m/s {where}"
+        elif m["E_beam"] > 0.05 * self.p["beam_power_W"] * self.p["beam_efficiency"] * 0.01 and \
+                abs(m["energy_error"]) > self.p["energy_tolerance"]:
+            reason = (f"energy balance off by {m['energy_error']:+.1%} of the beam energy "
+                      f"({m['E_residual']:.3g} J of {m['E_beam']:.3g} J) {where}")
+        if reason:
+            raise SimulationFailed(reason, self._metrics(partial=True))
+
+    # ---- loop
+    def run(self) -> dict:
+        """Run chunks to ``sim_time_s`` (or steady state); return the metrics."""
+        p, st, num = self.p, self.state, self.num
+        dt_chunk = self.chunk * num.dt
+        power = p["beam_power_W"] * p["beam_efficiency"]
+        block = max(1, int(round(0.01 / dt_chunk)))
+        if st.step == 0:
+            st.ledger.initial = sum(self._energy_now().values())  # includes the initial wire
+            st.ledger.wire_in = 0.0
+            st.t_next_restart = p["restart_interval_s"]
+        need_setup = True
+        chunks = 0
+        wall_block = time.perf_counter()
+        steps_block = 0
+        m = None
+        while st.t < self.t_end - 0.5 * dt_chunk:
+            need_setup |= self._feed_wire()
+            bx = self.geom.beam_x(st.t)
+            st.ledger.beam += deposit_beam(
+                self.lmp, p, self.geom, self._x(), self._e(), power * dt_chunk, bx, st.t, st.t + dt_chunk)
+            self._volumetric_heat(dt_chunk)
+            natoms = int(self.lmp.get_natoms())
+            t_lmp = time.perf_counter()
+            try:
+                self.deck(f"run {self.chunk} pre {'yes' if need_setup else 'no'} post no")
+            except Exception as exc:  # LAMMPS raises a plain Exception with its error message
+                raise SimulationFailed(f"LAMMPS error at t={st.t:.4g} s: {exc}", self._metrics(partial=True)) from exc
+            self.lammps_time += time.perf_counter() - t_lmp
+            st.t += dt_chunk
+            st.step += self.chunk
+            st.steps_since_shepard += self.chunk
+            self.particle_steps += natoms * self.chunk
+            steps_block += self.chunk
+            chunks += 1
+            temp, changed = self._phase_update()
+            need_setup = changed and self.num.cohesion is not None
+            if p["shepard_interval"] and st.steps_since_shepard >= p["shepard_interval"]:
+                self._shepard(self._types() == TYPE_LIQUID)
+                st.steps_since_shepard = 0
+            self._cap_temperature()
+            self._boundary_flux(temp, dt_chunk)
+            m = self._measure(self.thermal.temperature(self._e()))
+            self._watchdog(m, natoms)
+            st.rho_min, st.rho_max = min(st.rho_min, m["rho_min"]), max(st.rho_max, m["rho_max"])
+            st.t_max, st.v_max = max(st.t_max, m["T_max"]), max(st.v_max, m["v_max"])
+            if chunks % block == 0:
+                now = time.perf_counter()
+                m["steps_per_s"] = steps_block / (now - wall_block)
+                wall_block, steps_block = now, 0
+                self.series.append(m)
+                self._report(m)
+                self._write_series()
+                if self._steady() and p["stop_at_steady_state"]:
+                    break
+            if st.t >= st.t_next_restart - 0.5 * dt_chunk:
+                self.checkpoint()
+                st.t_next_restart += p["restart_interval_s"]
+        if m is not None and (not self.series or self.series[-1]["t"] != m["t"]):
+            m["steps_per_s"] = steps_block / max(time.perf_counter() - wall_block, 1e-9)
+            self.series.append(m)
+        self.checkpoint()
+        self._write_series()
+        return self._metrics()
+
+    def _report(self, m: dict) -> None:
+        info = {"t": m["t"], "steps_per_s": m["steps_per_s"], "T_max": m["T_max"], "n_liquid": m["n_liquid"],
+                "energy_error": m["energy_error"], "rho_min": m["rho_min"], "rho_max": m["rho_max"],
+                "v_max": m["v_max"]}
+        log.info("t %.4f s, %.0f steps/s, T_max %.0f K, %d liquid, rho %.3f-%.3f, v_max %.3g m/s, "
+                 "energy error %+.2e", m["t"], m["steps_per_s"], m["T_max"], m["n_liquid"], m["rho_min"],
+                 m["rho_max"], m["v_max"], m["energy_error"])
+        if self.progress:
+            self.progress(info)
+
+    def _steady(self, window: float = 0.2, tol: float = 0.05) -> bool:
+        """Record the first time the pool is steady: the means of the melt count and of the pool length over
+        the last ``window`` seconds differ from those over the window before by less than ``tol``.
+
+        Means, not ranges: dripping wire makes the instantaneous values fluctuate by 10-30 %. T_max is no
+        criterion: with the boiling cap it sits at T_boil from the first tenths of a second.
+        """
+        st = self.state
+        if math.isfinite(st.steady_time):
+            return True
+        if st.t < max(2 * beam_footprint_radius(self.p) / self.geom.substrate_speed, 2 * window):
+            return False
+        t = np.array([m["t"] for m in self.series])
+        last, before = t > st.t - window, (t > st.t - 2 * window) & (t <= st.t - window)
+        if last.sum() < 3 or before.sum() < 3:
+            return False
+        for key in ("n_liquid", "pool_length"):
+            v = np.array([m["n_liquid"] if key == "n_liquid" else m["pool_x_max"] - m["pool_x_min"]
+                          for m in self.series], dtype=float)
+            if not (np.isfinite(v[last | before]).all() and v[before].mean() > 0
+                    and abs(v[last].mean() / v[before].mean() - 1) < tol):
+                return False
+        st.steady_time = st.t
+        log.info("steady state at t = %.3f s", st.t)
+        return True
+
+    # ---- outputs
+    def _write_series(self) -> None:
+        if not self.series or not hasattr(self, "lmp") or not is_rank0(self.lmp):
+            return
+        keys = [k for k in self.series[0] if k not in ("t", "finite")]
+        ds = xr.Dataset({k: ("time", np.array([m.get(k, np.nan) for m in self.series], dtype=float))
+                         for k in keys},
+                        coords={"time": ("time", np.array([m["t"] for m in self.series]), {"units": "s"})})
+        units = {"T_max": "K", "rho_min": "1", "rho_max": "1", "v_max": "m s-1", "steps_per_s": "s-1",
+                 "pool_x_min": "m", "pool_x_max": "m", "energy_error": "1"}
+        for k in ds.data_vars:
+            ds[k].attrs["units"] = "J" if k.startswith("E_") else units.get(k, "1")
+        ds["t"] = ds["time"]
+        tmp = self.out / "timeseries.nc.tmp"
+        ds.to_netcdf(tmp, engine="scipy")
+        os.replace(tmp, self.out / "timeseries.nc")
+
+    def checkpoint(self) -> None:
+        """Write restart.bin and the Python state (each replaced atomically)."""
+        rdir = self.out / "restart"
+        self.deck(f"write_restart {rdir / 'restart.tmp.bin'}")
+        max_t = allreduce(self.lmp, self.per_id.max_t, "max")
+        if not is_rank0(self.lmp):
+            return
+        os.replace(rdir / "restart.tmp.bin", rdir / "restart.bin")
+        np.savez(rdir / "state.tmp.npz", state=json.dumps(asdict(self.state)), max_t=max_t,
+                 face_area=self.per_id.face_area, series=json.dumps(self.series),
+                 particle_steps=self.particle_steps)
+        os.replace(rdir / "state.tmp.npz", rdir / "state.npz")
+
+    def _read_checkpoint(self) -> None:
+        rdir = self.out / "restart"
+        data = np.load(rdir / "state.npz")
+        raw = json.loads(str(data["state"]))
+        raw["ledger"] = Ledger(**raw["ledger"])
+        self.state = RunState(**raw)
+        self.per_id.max_t = np.array(data["max_t"])
+        self.per_id.face_area = np.array(data["face_area"])
+        self.series = json.loads(str(data["series"]))
+        self.particle_steps = float(data["particle_steps"])
+        self.deck.note(f"resume from checkpoint at t = {self.state.t:.6g} s, step {self.state.step}")
+        self.deck(f"read_restart {rdir / 'restart.bin'}")
+        self.deck("group frozen delete")
+
+    # ---- metrics
+    def _gather(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Global positions (N,3), types and ids sorted by id (all ranks)."""
+        n = int(self.lmp.get_natoms())
+        x = np.ctypeslib.as_array(self.lmp.gather_atoms("x", 1, 3), shape=(n * 3,)).reshape(n, 3).copy()
+        types = np.ctypeslib.as_array(self.lmp.gather_atoms("type", 0, 1), shape=(n,)).copy()
+        ids = np.ctypeslib.as_array(self.lmp.gather_atoms("id", 0, 1), shape=(n,)).copy()
+        return x, types, ids
+
+    def _metrics(self, partial: bool = False) -> dict:
+        p, st, num = self.p, self.state, self.num
+        wall = time.perf_counter() - self.t0_wall
+        last = self.series[-1] if self.series else {}
+        out = {"n_particles": int(self.lmp.get_natoms()), "dx_mm": num.dx * 1e3, "dt_s": num.dt,
+               "sound_speed_used_m_s": num.c0, "n_steps": st.step, "simulated_time_s": st.t,
+               "steady_state_time_s": st.steady_time, "wall_time_s": wall,
+               "particle_steps_per_s": self.particle_steps / wall if wall > 0 else np.nan,
+               "python_time_share": 1 - self.lammps_time / wall if wall > 0 else np.nan,
+               "T_max_K": st.t_max, "melt_speed_max_m_s": st.v_max, "density_min": st.rho_min,
+               "density_max": st.rho_max, "energy_in_J": st.ledger.beam,
+               "energy_balance_error": last.get("energy_error", np.nan),
+               "evaporated_energy_J": st.ledger.evaporated, "boundary_heat_loss_J": st.ledger.boundary,
+               "absorbed_power_W": p["beam_power_W"] * p["beam_efficiency"]}
+        area_w = math.pi * (p["wire_diameter_mm"] / 2) ** 2
+        out["wire_supply_area_mm2"] = area_w * p["wire_feed_mm_s"] / p["substrate_speed_mm_s"]
+        out["wire_melt_power_W"] = (self.mat.rho * area_w * 1e-6 * p["wire_feed_mm_s"] * 1e-3
+                                    * (self.mat.cp * (self.mat.T_melt - self.T0) + self.mat.latent_heat))
+        if not partial:
+            out.update(self._bead_metrics(out["wire_supply_area_mm2"]))
+        return out
+
+    def _bead_metrics(self, supply_mm2: float) -> dict:
+        """Bead cross-section, pool and penetration from the final state (see :func:`reduce_bead`)."""
+        x, types, ids = self._gather()
+        max_t = allreduce(self.lmp, self.per_id.max_t, "max")
+        return reduce_bead(x, types, max_t[ids] >= self.mat.T_melt, self.geom, self.p, self.state.t, supply_mm2)
+
+
+def bead_window(geom: SceneGeometry, params: dict, t: float, pool_x_min: float) -> tuple[float, float] | None:
+    """x range (m) of the deposited bead to reduce: up to 2 mm of track behind the melt pool.
+
+    It starts after the start-up transient (one beam footprint behind the start of the track) and ends one
+    particle spacing behind the rear of the pool (the beam footprint if nothing is molten), both snapped inwards
+    to the edges of the initial lattice cells. None if shorter than two spacings.
+    """
+    r_fp, d = beam_footprint_radius(params), geom.dx
+    end = min(pool_x_min, geom.beam_x(t) - r_fp) - d
+    start = max(geom.beam_x(0.0) + r_fp, end - 2e-3)
+    # snap to the substrate lattice cells, so that the window holds whole columns of the initial lattice
+    start = geom.x_lo + math.ceil((start - geom.x_lo) / d - 1e-9) * d
+    end = geom.x_lo + math.floor((end - geom.x_lo) / d + 1e-9) * d
+    return (start, end) if end - start >= 2 * d - 1e-12 else None
+
+
+def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: SceneGeometry, params: dict,
+                t: float, supply_mm2: float) -> dict:
+    """Bead metrics from particle positions (m), types and ever-molten flags.
+
+    The net added area (mass balance) counts every particle in the window slab minus the substrate particles
+    it held at t = 0, so it is exact in mass. Width, height, contact angle, pool and penetration come from
+    :mod:`beadsim.sph.surface`.
+    """
+    from beadsim.sph import surface
+
+    out: dict = {}
+    liquid = types == TYPE_LIQUID
+    pool_x_min = float(x[liquid, 0].min()) if liquid.any() else np.inf
+    window = bead_window(geom, params, t, pool_x_min)
+    if liquid.any():
+        out.update(surface.pool_geometry(x[liquid], geom.dx))
+    if window is None:
+        log.warning("no solid bead behind the pool yet at t = %.3f s: bead metrics are NaN", t)
+        return out
+    deposit = types != TYPE_WIRE
+    in_win = (x[:, 0] >= window[0]) & (x[:, 0] < window[1]) & deposit
+    n_cells = round((window[1] - window[0]) / geom.dx)
+    length = n_cells * geom.dx
+    nx, ny, nz = geom.counts()
+    n_before = n_cells * ny * nz
+    net_area = (int(in_win.sum()) - n_before) * geom.dx ** 3 / length * 1e6
+    out["mass_balance_ratio"] = net_area / supply_mm2
+    out.update(surface.bead_cross_section(x[deposit], geom.dx, window, z_surface=0.0))
+    out["penetration_depth_mm"] = surface.penetration_depth(x, melted, geom.dx, window, z_surface=0.0)
+    if out.get("bead_width_mm"):
+        out["aspect_ratio"] = out["bead_height_mm"] / out["bead_width_mm"]
+    log.info("bead window %.2f-%.2f mm: net added area %.3g mm2 (wire %.3g mm2, ratio %.3f)",
+             window[0] * 1e3, window[1] * 1e3, net_area, supply_mm2, out["mass_balance_ratio"])
+    return out
+
+
+def run_case(params: dict, outdir: Path, progress=None, resume: bool = False,
+             material: Material | None = None) -> dict:
+    """Run one SPH bead case.
+
+    Parameters
+    ----------
+    params : dict
+        Every parameter of :func:`beadsim.parameters.all_parameters` (defaults filled in).
+    outdir : pathlib.Path
+        Output folder (created): deck.in, log.lammps, dumps/, restart/, timeseries.nc.
+    progress : callable, optional
+        Called with a dict (t, steps_per_s, T_max, n_liquid, energy_error, rho_min, rho_max, v_max) about
+        every 0.01 s of process time.
+    resume : bool
+        Continue from ``outdir/restart`` (written every ``restart_interval_s``) instead of starting over.
+    material : Material, optional
+        Material properties (e.g. from another materials file); default ``get_material(params["material"])``.
+
+    Returns
+    -------
+    dict
+        Metrics keyed by :data:`beadsim.metrics.METRICS` names.
+
+    Raises
+    ------
+    SimulationFailed
+        When the watchdog trips (non-finite values, lost particles, liquid density outside tolerance, speed
+        above the limit, energy balance off) or LAMMPS stops with an error; files written so far stay.
+    """
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    run = BeadRun(params, outdir, progress, material)
+    try:
+        run.open(resume)
+        metrics = run.run()
+    finally:
+        run._write_series()
+        if hasattr(run, "deck"):
+            run.deck.close()
+        if hasattr(run, "lmp"):
+            run.lmp.close()
+    metrics["wall_time_s"] = time.perf_counter() - run.t0_wall
+    if run.rank0:
+        write_metrics(outdir / "metrics.json", metrics)
+    return metrics
+
+
+def write_metrics(path: Path, metrics: dict) -> None:
+    """Write the metrics as JSON (NaN as null)."""
+    with open(path, "w") as fh:
+        json.dump({k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in metrics.items()},
+                  fh, indent=1)

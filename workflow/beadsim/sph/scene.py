@@ -1,0 +1,196 @@
+"""Particle scene of the SPH bead model: the substrate block and the wire.
+
+Frame: x is the travel direction, y across the bead, z up, the substrate top surface at z = 0, lengths in
+metres. The substrate is fixed; the beam axis and the wire move together at +V_s along x, starting at x = 0.
+The wire comes from the front (+x) and points down at ``wire_angle_deg``; its axis passes through the point
+(x_beam, 0, wire_height_mm) and its cut tip face lies in the plane through that point normal to the axis.
+Particles sit on a simple cubic lattice of spacing dx (substrate: cell centres, so the top layer is at -dx/2);
+the wire is a stack of slices normal to its axis, each a square grid of spacing dx inside the disc, spaced along
+the axis so that the particles carry the nominal wire mass (:func:`wire_slice_pitch`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Never-melted substrate particle.
+TYPE_SUBSTRATE = 1
+#: Never-melted wire particle (moves rigidly at the feed velocity).
+TYPE_WIRE = 2
+#: Particle above the melting temperature (flows).
+TYPE_LIQUID = 3
+#: Particle that melted and froze again (fixed in space).
+TYPE_RESOLIDIFIED = 4
+N_TYPES = 4
+
+
+@dataclass(frozen=True)
+class SceneGeometry:
+    """Sizes of the modelled block and the wire, in metres (velocities in m/s).
+
+    Attributes
+    ----------
+    dx : particle spacing
+    x_lo, x_hi, y_lo, y_hi, z_lo : extent of the substrate block (top at z = 0)
+    box_z_hi : top of the simulation box
+    cut_faces : names of block faces that cut the plate ('x_lo', 'x_hi', 'y_lo', 'y_hi', 'z_lo')
+    wire_radius, wire_height, wire_angle, wire_length : wire radius, axis height at the beam, angle from the
+        surface (rad), modelled length from tip to feed end
+    substrate_speed, wire_feed : V_s and V_w
+    """
+
+    dx: float
+    x_lo: float
+    x_hi: float
+    y_lo: float
+    y_hi: float
+    z_lo: float
+    box_z_hi: float
+    cut_faces: tuple
+    wire_radius: float
+    wire_height: float
+    wire_angle: float
+    wire_length: float
+    substrate_speed: float
+    wire_feed: float
+
+    @property
+    def wire_axis(self) -> np.ndarray:
+        """Unit vector along the wire from its tip towards the feed end."""
+        return np.array([math.cos(self.wire_angle), 0.0, math.sin(self.wire_angle)])
+
+    @property
+    def wire_velocity(self) -> np.ndarray:
+        """Velocity of unmelted wire in the substrate frame, m/s: travel plus feed towards the tip."""
+        return np.array([self.substrate_speed, 0.0, 0.0]) - self.wire_feed * self.wire_axis
+
+    def beam_x(self, t: float) -> float:
+        """x of the beam axis at process time t (s)."""
+        return self.substrate_speed * t
+
+    def counts(self) -> tuple[int, int, int]:
+        """Number of substrate lattice cells along x, y, z."""
+        return tuple(int(round(v / self.dx)) for v in
+                     (self.x_hi - self.x_lo, self.y_hi - self.y_lo, -self.z_lo))
+
+
+def _snap(length: float, dx: float) -> float:
+    """Round a length up to a whole number of cells (at least 2); widths use an even number, so that the
+    cell-centred lattice is symmetric about y = 0."""
+    return max(2, math.ceil(length / dx - 1e-9)) * dx
+
+
+def build_geometry(params: dict) -> SceneGeometry:
+    """Size the modelled block and the wire from the case parameters.
+
+    ``domain = auto``: the block spans the scanned track over ``sim_time_s`` plus ``domain_margin_mm`` behind
+    the start, ahead of the wire and on both sides, ``domain_depth_mm`` deep, each never larger than the plate.
+    ``domain = plate``: the whole plate, with the start of the track ``domain_margin_mm`` plus the beam radius
+    from its rear end. Faces where the block is smaller than the plate are ``cut_faces``.
+    """
+    mm = 1e-3
+    dx = params["resolution_mm"] * mm
+    margin = params["domain_margin_mm"] * mm
+    radius = params["wire_diameter_mm"] * mm / 2
+    alpha = math.radians(params["wire_angle_deg"])
+    wire_len = params["wire_length_mm"] * mm
+    height = params["wire_height_mm"] * mm
+    vs = params["substrate_speed_mm_s"] * mm
+    beam_r = params["scan_diameter_mm"] * mm / 2 + 3 * params["beam_spot_radius_mm"] * mm
+    wire_front = wire_len * math.cos(alpha) + radius * math.sin(alpha)
+    plate = (params["substrate_length_mm"] * mm, params["substrate_width_mm"] * mm,
+             params["substrate_thickness_mm"] * mm)
+    rear = _snap(beam_r + margin, dx)
+    if params["domain"] == "plate":
+        length, width, depth = _snap(plate[0], dx), 2 * _snap(plate[1] / 2, dx), _snap(plate[2], dx)
+    else:
+        length = _snap(min(rear + vs * params["sim_time_s"] + max(beam_r, wire_front) + margin, plate[0]), dx)
+        width = 2 * _snap(min(max(beam_r, radius) + margin, plate[1] / 2), dx)
+        depth = _snap(min(params["domain_depth_mm"] * mm, plate[2]), dx)
+    rear = min(rear, length / 2)
+    cut = []
+    if length < plate[0] - dx / 2:
+        cut += ["x_lo", "x_hi"]
+    if width < plate[1] - dx / 2:
+        cut += ["y_lo", "y_hi"]
+    if depth < plate[2] - dx / 2:
+        cut += ["z_lo"]
+    top = height + wire_len * math.sin(alpha) + radius + 2 * dx
+    return SceneGeometry(dx=dx, x_lo=-rear, x_hi=length - rear, y_lo=-width / 2, y_hi=width / 2, z_lo=-depth,
+                         box_z_hi=top, cut_faces=tuple(cut), wire_radius=radius, wire_height=height,
+                         wire_angle=alpha, wire_length=wire_len, substrate_speed=vs,
+                         wire_feed=params["wire_feed_mm_s"] * mm)
+
+
+def substrate_positions(geom: SceneGeometry) -> np.ndarray:
+    """Cell-centred lattice filling the block, shape (N, 3), metres."""
+    nx, ny, nz = geom.counts()
+    ix, iy, iz = np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij")
+    d = geom.dx
+    pos = np.column_stack([geom.x_lo + (ix.ravel() + 0.5) * d, geom.y_lo + (iy.ravel() + 0.5) * d,
+                           -(iz.ravel() + 0.5) * d])
+    return pos
+
+
+def face_areas(geom: SceneGeometry, pos: np.ndarray) -> np.ndarray:
+    """Area (m^2) of cut plate faces carried by each substrate particle (0 inside; corners add up)."""
+    d = geom.dx
+    area = np.zeros(len(pos))
+    tests = {"x_lo": pos[:, 0] < geom.x_lo + d, "x_hi": pos[:, 0] > geom.x_hi - d,
+             "y_lo": pos[:, 1] < geom.y_lo + d, "y_hi": pos[:, 1] > geom.y_hi - d,
+             "z_lo": pos[:, 2] < geom.z_lo + d}
+    for face in geom.cut_faces:
+        area[tests[face]] += d * d
+    return area
+
+
+def _disc_offsets(radius: float, dx: float) -> np.ndarray:
+    """Square-grid points (u, v) inside a disc, choosing the grid offset whose count best matches the area."""
+    best = None
+    n = int(math.ceil(radius / dx)) + 1
+    for shift in (0.0, 0.5):
+        g = (np.arange(-n, n + 1) + shift) * dx
+        u, v = np.meshgrid(g, g, indexing="ij")
+        inside = u ** 2 + v ** 2 <= radius ** 2
+        pts = np.column_stack([u[inside], v[inside]])
+        err = abs(len(pts) * dx * dx - math.pi * radius ** 2)
+        if best is None or err < best[0]:
+            best = (err, pts)
+    return best[1]
+
+
+def wire_slice(geom: SceneGeometry, s: float, beam_x: float) -> np.ndarray:
+    """Particles of one wire slice at axial distance s (m) from the tip plane, beam at beam_x; shape (n, 3).
+
+    Points that would sit inside the substrate (z < dx/2) are dropped.
+    """
+    axis = geom.wire_axis
+    e_u = np.array([-math.sin(geom.wire_angle), 0.0, math.cos(geom.wire_angle)])
+    e_v = np.array([0.0, 1.0, 0.0])
+    uv = _disc_offsets(geom.wire_radius, geom.dx)
+    centre = np.array([beam_x, 0.0, geom.wire_height]) + s * axis
+    pos = centre + uv[:, :1] * e_u + uv[:, 1:] * e_v
+    return pos[pos[:, 2] >= geom.dx / 2]
+
+
+def wire_slice_count(geom: SceneGeometry) -> int:
+    """Particles per full wire slice."""
+    return len(_disc_offsets(geom.wire_radius, geom.dx))
+
+
+def wire_slice_pitch(geom: SceneGeometry) -> float:
+    """Axial distance (m) between wire slices such that the particles carry the nominal wire mass per length:
+    n_slice dx^3 / (pi r^2). Within a few percent of dx; it corrects the count of the square grid in the disc
+    (+3 % at d 1.2 mm, dx 0.3 mm; +27 % at dx 0.4 mm)."""
+    return wire_slice_count(geom) * geom.dx ** 3 / (math.pi * geom.wire_radius ** 2)
+
+
+def initial_wire(geom: SceneGeometry) -> tuple[np.ndarray, float]:
+    """Wire particles from the tip to the feed end at t = 0, and the axial position (m) of the last slice."""
+    pitch = wire_slice_pitch(geom)
+    s_values = np.arange(0.5, geom.wire_length / pitch) * pitch
+    pos = np.vstack([wire_slice(geom, s, geom.beam_x(0.0)) for s in s_values])
+    return pos, float(s_values[-1])
