@@ -8,6 +8,7 @@ A failed run is a result: the sweep goes on and aggregation reports it with its 
 
 from __future__ import annotations
 
+import json
 import logging
 import time
 import traceback
@@ -21,26 +22,41 @@ from beadsim.provenance import provenance
 log = logging.getLogger("beadsim.runner")
 
 
-def run_model(params: dict, outdir: Path, materials_file=None, tasks: int = 1, mpi: str = "mpirun") -> dict:
+def run_model(params: dict, outdir: Path, materials_file=None, tasks: int = 1, mpi: str = "mpirun",
+              run_id: str = "") -> dict:
     """Dispatch to the model named by ``params['model']``; return its metrics.
 
     SPH runs with ``tasks > 1`` are launched as ``<mpi> -n <tasks> python -m beadsim.sph.mpi_main`` (``mpi``
     may hold options, e.g. "srun --mpi=pmi2"); the reduced model always runs in this process.
     """
     material = get_material(params["material"], materials_file)
+    resume = params["model"] == "sph" and _can_resume(params, outdir)
+    write_json(outdir / "params.json", {"run_id": run_id, **params})
     if params["model"] == "reduced":
         from beadsim.reduced import run_reduced
 
         return run_reduced(params, material)
     if params["model"] == "sph":
+        if resume:
+            log.info("resuming from the checkpoint in %s", outdir / "restart")
         if tasks > 1:
             from beadsim.sph.mpi_main import run_mpi
 
-            return run_mpi(params, outdir, tasks=tasks, mpi=mpi, materials_file=materials_file)
+            return run_mpi(params, outdir, tasks=tasks, mpi=mpi, materials_file=materials_file, resume=resume)
         from beadsim.sph.driver import run_case as run_sph
 
-        return run_sph(params, outdir, material=material)
+        return run_sph(params, outdir, material=material, resume=resume)
     raise ValueError(f"model {params['model']!r} is not one of reduced, sph")
+
+
+def _can_resume(params: dict, outdir: Path) -> bool:
+    """A killed SPH run left a checkpoint made with the same parameters: continue it instead of starting over."""
+    old = outdir / "params.json"
+    if not (outdir / "restart" / "state.npz").exists() or not old.exists():
+        return False
+    previous = json.loads(old.read_text())
+    previous.pop("run_id", None)
+    return previous == json.loads(json.dumps(params))
 
 
 def run_case(params: dict, outdir: str | Path, run_id: str = "", materials_file=None, tasks: int = 1,
@@ -54,11 +70,10 @@ def run_case(params: dict, outdir: str | Path, run_id: str = "", materials_file=
     """
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
-    write_json(outdir / "params.json", {"run_id": run_id, **params})
     t0 = time.perf_counter()
     status, reason, metrics = "ok", "", {}
     try:
-        metrics = run_model(params, outdir, materials_file, tasks=tasks, mpi=mpi)
+        metrics = run_model(params, outdir, materials_file, tasks=tasks, mpi=mpi, run_id=run_id)
     except SimulationFailed as exc:
         status, reason, metrics = "failed", exc.reason, exc.metrics
         log.error("run %s failed: %s", run_id, exc.reason)

@@ -1,0 +1,81 @@
+"""Run one SPH case on several MPI ranks: ``<launcher> -n N python -m beadsim.sph.mpi_main PARAMS OUTDIR``.
+
+Every rank runs the same driver (LAMMPS splits the particles; the driver reduces whatever it computes between
+chunks over ranks). Rank 0 writes ``mpi_result.json`` (status, reason, metrics), which :func:`run_mpi`, called by
+the runner in the parent process, turns back into metrics or a :class:`SimulationFailed`.
+"""
+
+from __future__ import annotations
+
+import json
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+from beadsim.errors import SimulationFailed
+from beadsim.io import write_json
+
+RESULT = "mpi_result.json"
+
+
+def run_mpi(params: dict, outdir: Path, tasks: int, mpi: str = "mpirun", materials_file=None,
+            resume: bool = False, timeout: float | None = None) -> dict:
+    """Launch the case on ``tasks`` ranks with ``mpi`` (e.g. "mpirun", "srun --mpi=pmi2"); return its metrics.
+
+    Raises
+    ------
+    SimulationFailed
+        With the driver's reason, or with the launcher's exit code and the end of its output when the ranks died
+        without writing a result.
+    """
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    (outdir / RESULT).unlink(missing_ok=True)
+    write_json(outdir / "mpi_params.json", {"params": params, "materials_file": str(materials_file or ""),
+                                            "resume": resume})
+    launcher = shlex.split(mpi)
+    if launcher and Path(launcher[0]).name == "mpirun":
+        from beadsim.lammps_env import mpirun
+
+        launcher[0] = mpirun()
+    cmd = [*launcher, "-n", str(tasks), sys.executable, "-m", "beadsim.sph.mpi_main", str(outdir)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    (outdir / "mpi.log").write_text(proc.stdout + proc.stderr)
+    if not (outdir / RESULT).exists():
+        tail = " | ".join((proc.stdout + proc.stderr).strip().splitlines()[-3:])
+        raise SimulationFailed(f"MPI run ({' '.join(cmd[:3])} ...) exited with code {proc.returncode} and no "
+                               f"result: {tail}")
+    result = json.loads((outdir / RESULT).read_text())
+    metrics = {k: (float("nan") if v is None else v) for k, v in result["metrics"].items()}
+    metrics["mpi_ranks"] = result["ranks"]
+    if result["status"] != "ok":
+        raise SimulationFailed(result["reason"], metrics)
+    return metrics
+
+
+def main(outdir: str) -> None:
+    from beadsim.lammps_env import preload_mpi
+
+    preload_mpi()
+    from mpi4py import MPI
+
+    from beadsim.materials import get_material
+    from beadsim.sph.driver import run_case
+
+    out = Path(outdir)
+    spec = json.loads((out / "mpi_params.json").read_text())
+    params = spec["params"]
+    material = get_material(params["material"], spec["materials_file"] or None)
+    comm = MPI.COMM_WORLD
+    status, reason, metrics = "ok", "", {}
+    try:
+        metrics = run_case(params, out, material=material, resume=spec["resume"])
+    except SimulationFailed as exc:
+        status, reason, metrics = "failed", exc.reason, exc.metrics
+    if comm.rank == 0:
+        write_json(out / RESULT, {"status": status, "reason": reason, "metrics": metrics, "ranks": comm.size})
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])
