@@ -44,3 +44,15 @@ def test_dataset_from_real_runs(tmp_path, experiments):
     assert grid is not None and dict(grid.sizes) == {"beam_power_W": 2, "substrate_speed_mm_s": 2}
     assert grid["bead_width_mm"].sel(beam_power_W=1200, substrate_speed_mm_s=6) == \
         back["bead_width_mm"].sel(case="P1200_Vs6")
+
+
+def test_gridded_view_of_a_single_axis(tmp_path, experiments):
+    cfg = {"study": "t", "sweep": [{"grid": {"beam_power_W": [900, 1100]}}]}
+    table = design(cfg, experiments)
+    results = []
+    for run_id in table.index:
+        run_case(case_params(table, run_id), tmp_path / run_id, run_id=run_id)
+        results.append(tmp_path / run_id / "result.json")
+    grid = gridded(build_dataset(results, None, cfg, table))
+    assert list(grid.dims) == ["beam_power_W"] and grid["beam_power_W"].attrs["units"] == "W"
+    assert grid["pool_width_mm"].sel(beam_power_W=1100) > grid["pool_width_mm"].sel(beam_power_W=900)

@@ -97,3 +97,20 @@ def test_lint_is_clean():
     proc = subprocess.run([sys.executable, "-m", "snakemake", "--snakefile", str(ROOT / "Snakefile"), "--lint"],
                           capture_output=True, text=True, cwd=ROOT, timeout=300)
     assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_sph_blow_up_is_recorded_and_the_study_completes(tmp_path):
+    config = tmp_path / "tiny_sph.yaml"
+    shutil.copy(ROOT / "tests" / "configs" / "tiny_sph.yaml", config)
+    proc = snakemake(tmp_path, config)
+    assert proc.returncode == 0, proc.stderr[-4000:]
+    out = tmp_path / "results" / "tiny_sph"
+    ds = xr.load_dataset(out / "dataset.nc")
+    assert dict(zip(ds["case"].values, ds["status"].values)) == {"dtf1": "ok", "dtf8": "failed"}
+    assert "density" in str(ds["reason"].sel(case="dtf8").values)
+    assert ds.attrs["lammps_versions"] == "20250722"
+    classes = (out / "stability" / "classes.csv").read_text()
+    assert "blown_up" in classes and ("stable" in classes or "degraded" in classes)
+    for run in ("dtf1", "dtf8"):
+        assert (out / "runs" / run / "bead.png").stat().st_size > 10_000
+        assert (out / "runs" / run / "deck.in").exists()

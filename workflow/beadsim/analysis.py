@@ -204,3 +204,19 @@ def pareto_front(cost: np.ndarray, error: np.ndarray) -> np.ndarray:
         dominated = ok & (cost <= cost[i]) & (error <= error[i]) & ((cost < cost[i]) | (error < error[i]))
         front[i] = not dominated.any()
     return front
+
+
+def stability_table(ds: xr.Dataset, density_band: float = 0.05, energy_band: float = 0.02) -> pd.DataFrame:
+    """One row per run: its swept parameters, the quantities the class rests on, the class and the reason."""
+    from beadsim.dataset import swept_parameters
+
+    cols = {p: ds[p].values for p in swept_parameters(ds)}
+    df = pd.DataFrame({"run_id": ds["case"].values, **cols})
+    for k in ("density_min", "density_max", "energy_balance_error", "melt_speed_max_m_s", "dt_s",
+              "simulated_time_s"):
+        df[k] = ds[k].values
+    df["status"] = ds["status"].values
+    df["reason"] = ds["reason"].values
+    df["class"] = [stability_class(s, a, b, e, density_band, energy_band) for s, a, b, e in
+                   zip(df["status"], df["density_min"], df["density_max"], df["energy_balance_error"])]
+    return df

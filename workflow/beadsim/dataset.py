@@ -121,10 +121,14 @@ def gridded(ds: xr.Dataset) -> xr.Dataset | None:
     if n_grid != ds.sizes["case"]:
         return None
     keep = [c for c in ds.coords if c not in axes and c != "case"]
-    flat = ds.reset_coords(keep, drop=True).set_index(case=axes)
-    if flat.indexes["case"].has_duplicates:
-        return None
-    grid = flat.unstack("case")
+    flat = ds.reset_coords(keep, drop=True)
+    if len(axes) == 1:
+        grid = flat.swap_dims(case=axes[0]).drop_vars("case")
+    else:
+        flat = flat.set_index(case=axes)
+        if flat.indexes["case"].has_duplicates:
+            return None
+        grid = flat.unstack("case")
     for a in axes:
         grid[a].attrs = ds[a].attrs
     grid.attrs = ds.attrs

@@ -236,3 +236,33 @@ def convergence_plot(ds: xr.Dataset, table: pd.DataFrame, parameter: str) -> plt
         axes[0, 0].legend(fontsize=7, title="square at 0: extrapolated +- GCI", title_fontsize=7)
     fig.tight_layout()
     return fig
+
+
+STABILITY_COLORS = {"stable": "tab:green", "degraded": "tab:orange", "blown_up": "tab:red"}
+
+
+def stability_map(ds: xr.Dataset, table: pd.DataFrame, x: str | None, y: str | None,
+                  facet: str | None) -> plt.Figure:
+    """Runs over two numerics axes (one panel per facet value), coloured by stability class; the defaults
+    (dt_factor 1, the study's base values) are ringed."""
+    axes = [a for a in swept_parameters(ds) if ds[a].dtype.kind == "f"]
+    x = x or (axes[0] if axes else None)
+    y = y or next((a for a in axes if a != x), None)
+    facets = list(pd.unique(table[facet])) if facet and facet in table else [None]
+    fig, grid = plt.subplots(1, len(facets), figsize=(4.5 * len(facets), 3.8), squeeze=False)
+    for ax, fv in zip(grid[0], facets):
+        sub = table if fv is None else table[table[facet] == fv]
+        yv = sub[y] if y else np.zeros(len(sub))
+        for cls, color in STABILITY_COLORS.items():
+            part = sub["class"] == cls
+            ax.scatter(sub[x][part], yv[part], c=color, s=90, label=cls, edgecolors="k")
+        if x == "dt_factor":
+            ax.axvline(1.0, color="0.5", ls="--", lw=1)
+            ax.text(1.0, ax.get_ylim()[1], " default", va="top", fontsize=7, color="0.4")
+        ax.set_xlabel(label(ds[x]))
+        if y:
+            ax.set_ylabel(label(ds[y]))
+        ax.set_title(f"{facet} = {fv}" if fv is not None else "", fontsize=9)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig

@@ -129,6 +129,15 @@ def build_schema() -> dict:
                                        "(sweep it over the measured modes)",
                         "properties": {"parameter": {"enum": numeric, "default": "beam_efficiency"}},
                     },
+                    "stability": {
+                        "type": "object",
+                        "additionalProperties": False,
+                        "description": "classify runs stable / degraded / blown up over the swept numerics",
+                        "properties": {
+                            "density_band": {"type": "number", "exclusiveMinimum": 0, "default": 0.05},
+                            "energy_band": {"type": "number", "exclusiveMinimum": 0, "default": 0.02},
+                        },
+                    },
                     "convergence": {
                         "type": "object",
                         "additionalProperties": False,

@@ -50,3 +50,30 @@ rule analyze_convergence:
         f"logs/{STUDY}/analyze_convergence.log",
     script:
         "../scripts/analyze_convergence.py"
+
+
+rule analyze_stability:
+    input:
+        f"{OUT}/dataset.nc",
+    output:
+        table=report(
+            f"{OUT}/stability/classes.csv",
+            caption="../report/stability.rst",
+            category="Stability",
+            labels={"table": "run classes"},
+        ),
+        figure=report(
+            f"{OUT}/stability/stability_map.png",
+            caption="../report/stability.rst",
+            category="Stability",
+            labels={"figure": "stability map"},
+        ),
+    params:
+        options=lookup(dpath="analysis/stability", within=config, default={}),
+        axes=config.get("report", {}),
+    conda:
+        "../../envs/beadsim.yaml"
+    log:
+        f"logs/{STUDY}/analyze_stability.log",
+    script:
+        "../scripts/analyze_stability.py"

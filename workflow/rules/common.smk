@@ -57,6 +57,8 @@ def get_final_output():
     extra = []
     if "calibration" in analyses:
         extra += [f"{OUT}/calibration/leave_one_out.csv", f"{OUT}/calibration/curves.png"]
+    if "stability" in analyses:
+        extra += [f"{OUT}/stability/classes.csv", f"{OUT}/stability/stability_map.png"]
     if "convergence" in analyses:
         extra += [f"{OUT}/convergence/richardson.csv", f"{OUT}/convergence/convergence.png"]
     sph_runs = [r for r in RUN_IDS if DESIGN.loc[r, "model"] == "sph"]
