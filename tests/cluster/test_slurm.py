@@ -227,7 +227,7 @@ def test_sph_case_runs_on_two_ranks(tmp_path_factory):
     pytest.importorskip("beadsim.sph.mpi_main", reason="beadsim.sph.mpi_main (SPH on MPI ranks) is missing")
     work, path = study_dir(tmp_path_factory, "sph2", SPH_STUDY)
     run = work / "results" / "sph2" / "runs" / "base"
-    proc = run_snakemake(work, path, "slurm", str(run / "result.json"))
+    proc = run_snakemake(work, path, "slurm", str((run / "result.json").relative_to(work)))
     assert proc.returncode == 0, proc.stderr[-6000:]
     result = json.loads((run / "result.json").read_text())
     params = json.loads((run / "params.json").read_text())
