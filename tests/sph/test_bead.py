@@ -117,3 +117,31 @@ def test_beam_lands_on_the_surface_seen_from_above():
     assert r_mean == pytest.approx(radius + sigma ** 2 / radius, rel=0.03)
     under_bar = (np.abs(shadowed[:, 1]) < 0.3e-3) & (shadowed[:, 2] < 0)
     assert e_shadow[under_bar].sum() == 0 and e_shadow[len(flat):].sum() > 0.1
+
+
+def test_compression_density_sees_packing():
+    """Kernel-sum density: rho0 inside the undisturbed lattice, rho0 / s^3 (within 1 %) inside a lattice shrunk
+    by s, below rho0 at a free surface (where the correction must not act), raised for a collapsed pair; the
+    targets are the sources and exactly the particles within h of them."""
+    from scipy.spatial.distance import cdist
+
+    from beadsim.sph.driver import compression_density
+
+    dx, h, rho0 = 0.3e-3, 0.75e-3, 4420.0
+    g = np.arange(-5, 6) * dx
+    lattice = np.array(np.meshgrid(g, g, g, indexing="ij")).reshape(3, -1).T
+    centre = np.flatnonzero((np.abs(lattice) < 1e-12).all(axis=1))
+
+    def at(pos, i):
+        targets, rho = compression_density(pos, i, dx, h, rho0)
+        return rho[np.searchsorted(targets, i)]
+
+    targets, rho = compression_density(lattice, centre, dx, h, rho0)
+    assert np.array_equal(targets, np.flatnonzero(cdist(lattice, lattice[centre])[:, 0] <= h))
+    assert at(lattice, centre)[0] == pytest.approx(rho0, rel=1e-12)
+    assert at(0.9 * lattice, centre)[0] == pytest.approx(rho0 / 0.9 ** 3, rel=0.01)
+    top = np.flatnonzero((np.abs(lattice[:, :2]) < 1e-12).all(axis=1) & (lattice[:, 2] > g[-1] - 1e-12))
+    assert at(lattice, top)[0] < 0.8 * rho0
+    paired = lattice.copy()
+    paired[centre] += [0.5 * dx, 0.0, 0.0]  # the centre particle halfway to its +x neighbour
+    assert at(paired, centre)[0] > 1.01 * rho0

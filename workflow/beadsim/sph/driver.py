@@ -6,7 +6,10 @@ artificial viscosity, gravity) and energy (eq. 21: heat conduction with D = k / 
 particles seen from above inside the footprint, creates wire slices at the feed end, switches particle types
 between substrate / wire / liquid / resolidified, resets the velocities of frozen particles (to zero, or to the
 feed velocity for wire that never melted), resets the density of frozen particles, applies a Shepard filter to
-the liquid density, caps temperatures at boiling (the excess counted as evaporation), removes heat through the
+the liquid density, raises the density of compressed particles in and around the melt to the kernel-sum density
+of their packing (:func:`compression_density`: the continuity density does not see melt collapsing onto the
+solid, whose density is reset, so without it the pool bottom packs up to 2x denser and the bead loses volume),
+caps temperatures at boiling (the excess counted as evaporation), removes heat through the
 cut faces of the block (far-field condition), closes the energy ledger and runs the watchdog.
 
 Energy convention: ``esph`` holds the internal energy of a particle in joules and ``cv`` its heat capacity
@@ -191,6 +194,54 @@ def lucy_kernel(r: np.ndarray, h: float) -> np.ndarray:
     """3-D Lucy kernel W(r, h) (1/m^3), the kernel of the LAMMPS SPH pair styles."""
     q = np.clip(r / h, 0.0, 1.0)
     return 105.0 / (16.0 * math.pi * h ** 3) * (1 + 3 * q) * (1 - q) ** 3
+
+
+def lattice_volume_fraction(dx: float, h: float) -> float:
+    """Kernel volume fraction sum_j dx^3 W(r_j, h) (self included) of a particle inside a simple-cubic lattice
+    of spacing dx (m) with full kernel support: the reference of :func:`compression_density`."""
+    n = int(math.ceil(h / dx))
+    g = np.arange(-n, n + 1) * dx
+    r = np.sqrt(g[:, None, None] ** 2 + g[None, :, None] ** 2 + g[None, None, :] ** 2)
+    return float(dx ** 3 * lucy_kernel(r, h).sum())
+
+
+def compression_density(x_all: np.ndarray, sources: np.ndarray, dx: float, h: float,
+                        rho0: float) -> tuple[np.ndarray, np.ndarray]:
+    """Density (kg/m^3) that the particle arrangement implies, for ``sources`` and every particle within h of
+    them.
+
+    rho0 phi_i / phi_ref with phi_i = sum_j dx^3 W(r_ij, h) over all particles j of ``x_all`` (m) within h,
+    the particle itself included, and phi_ref the same sum on the undisturbed lattice
+    (:func:`lattice_volume_fraction`). Unlike the continuity density it sees particles packed closer than the
+    lattice spacing (collapse onto a neighbour or into a void); at a free surface it falls below rho0.
+
+    Parameters
+    ----------
+    x_all : (N, 3) positions of every particle that can be a neighbour (m)
+    sources : indices into ``x_all`` of the particles around which to evaluate (the melt)
+    dx, h : lattice spacing and kernel cutoff (m)
+    rho0 : reference density (kg/m^3)
+
+    Returns
+    -------
+    targets : sorted indices into ``x_all``: ``sources`` and the particles within h of them
+    density : the implied density at ``targets`` (kg/m^3)
+    """
+    if len(sources) == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0)
+    xs = x_all[sources]
+    # neighbours of the targets lie within 2 h of a source
+    box = np.flatnonzero(((x_all >= xs.min(axis=0) - 2 * h) & (x_all <= xs.max(axis=0) + 2 * h)).all(axis=1))
+    box = box[np.isfinite(cKDTree(xs).query(x_all[box], distance_upper_bound=2 * h)[0])]
+    xb = x_all[box]
+    i, j = cKDTree(xb).query_pairs(h, output_type="ndarray").T
+    w = lucy_kernel(np.linalg.norm(xb[i] - xb[j], axis=1), h)
+    phi = dx ** 3 * (lucy_kernel(np.zeros(1), h)[0] + np.bincount(i, w, len(box)) + np.bincount(j, w, len(box)))
+    is_source = np.isin(box, sources)
+    near = is_source.copy()
+    near[i[is_source[j]]] = True
+    near[j[is_source[i]]] = True
+    return box[near], rho0 * phi[near] / lattice_volume_fraction(dx, h)
 
 
 # ----------------------------------------------------------------------------------------------- beam
@@ -599,6 +650,31 @@ class BeadRun:
         den = np.bincount(row, weights=w / rho_all[col], minlength=len(idx)) + w0 / rho_all[idx]
         rho_all[idx] = num / den
 
+    def _compression_floor(self) -> None:
+        """Raise the density of compressed particles in and around the melt to what their packing implies.
+
+        For this rank's liquid particles and its frozen particles within h of any liquid particle (own or ghost;
+        ghost types are those of the last LAMMPS communication),
+        rho_i = max(rho_i, min(:func:`compression_density`, (1 + tol / 2) rho0)) with tol the watchdog's
+        ``density_tolerance``, evaluated over this rank's own and ghost particles (ghosts reach h + skin
+        beyond the rank, so every target sees all its neighbours). One-sided: it detects particles packed closer
+        than the lattice (melt collapsing onto the solid, pairing), which the continuity density, the Shepard
+        filter and the solid density reset miss, and leaves free surfaces (packing below the lattice) alone.
+        A frozen particle that gets a density above rho0 pushes the melt away from the compressed spot.
+        """
+        nlocal = self._nlocal()
+        nall = nlocal + self.lmp.extract_setting("nghost")
+        liquid = np.flatnonzero(self.lmp.numpy.extract_atom("type", nelem=nall) == TYPE_LIQUID)
+        if len(liquid) == 0:
+            return
+        x = self.lmp.numpy.extract_atom("x", nelem=nall, dim=3)
+        targets, floor = compression_density(x, liquid, self.num.dx, self.num.h, self.mat.rho)
+        own = targets < nlocal
+        targets, floor = targets[own], floor[own]
+        cap = self.mat.rho * (1 + 0.5 * self.p["density_tolerance"])
+        rho = self._rho()
+        rho[targets] = np.maximum(rho[targets], np.minimum(floor, cap))
+
     def _volumetric_heat(self, dt_chunk: float) -> None:
         """Add the block's share (block volume / plate volume) of ``volumetric_heat_W`` evenly to every
         particle that is not unmelted wire."""
@@ -749,6 +825,7 @@ class BeadRun:
             if p["shepard_interval"] and st.steps_since_shepard >= p["shepard_interval"]:
                 self._shepard(self._types() == TYPE_LIQUID)
                 st.steps_since_shepard = 0
+            self._compression_floor()
             self._cap_temperature()
             self._boundary_flux(temp, dt_chunk)
             m = self._measure(self.thermal.temperature(self._e()))
