@@ -48,6 +48,12 @@ test-cluster: env
 	bash .ci/slurm/start.sh && BEADSIM_SLURM=1 $(BIN)/python -m pytest -q tests/cluster $(PYTEST_ARGS); \
 	rc=$$?; bash .ci/slurm/stop.sh; exit $$rc
 
+# Speed benchmark of the SPH model (beadsim/bench.py): throughput on 1 and 2 ranks, the Table 4 modes with all
+# speed levers, the whole plate (estimated from its per-step cost), window vs whole plate at a coarse dx.
+# Options: make bench BENCH_ARGS="--dx 0.3 --modes 1"   (python -m beadsim.bench --help)
+bench: env
+	$(BIN)/python -m beadsim.bench $(BENCH_ARGS)
+
 lint: env
 	$(BIN)/snakemake --lint --configfile $(CONFIG)
 

@@ -50,6 +50,7 @@ def test_stability_classes():
     from beadsim.analysis import stability_class
 
     assert stability_class("failed", np.nan, np.nan, np.nan) == "blown_up"
+    assert stability_class("failed", np.nan, np.nan, np.nan, reason="error: KeyError: 'x'") == "error"
     assert stability_class("ok", 0.98, 1.03, 0.01) == "stable"
     assert stability_class("ok", 0.90, 1.03, 0.01) == "degraded"
     assert stability_class("ok", 0.98, 1.03, 0.08) == "degraded"
@@ -61,3 +62,34 @@ def test_pareto_front():
     cost = np.array([1.0, 2.0, 3.0, 2.5, 10.0, np.nan])
     err = np.array([0.5, 0.2, 0.25, 0.1, 0.1, 0.0])
     assert list(pareto_front(cost, err)) == [True, True, False, True, False, False]
+
+
+def test_speed_accuracy_against_table1_and_the_finest_run(experiments):
+    """Three runs of mode 1 on real reduced-model records with SPH-like labels: the errors against Table 1 and
+    against the finest successful run are what the numbers say, and the Pareto flags follow."""
+    import xarray as xr
+
+    from beadsim.analysis import speed_accuracy_table
+
+    row = experiments.loc[1]
+    n = 4
+    ds = xr.Dataset(
+        {"bead_width_mm": ("case", [3.3, 3.63, 4.0, np.nan]), "bead_height_mm": ("case", [1.0, 0.9, 0.5, np.nan]),
+         "job_wall_time_s": ("case", [100.0, 10.0, 1.0, 5.0]),
+         "status": ("case", ["ok", "ok", "ok", "failed"]), "model": ("case", ["sph", "sph", "reduced", "sph"]),
+         "resolution_mm": ("case", [0.2, 0.4, 0.3, 0.1])},
+        coords={"case": ["fine", "coarse", "red", "bad"]})
+    for k in ("material", "beam_power_W", "substrate_speed_mm_s", "wire_feed_mm_s", "wire_diameter_mm",
+              "scan_diameter_mm"):
+        ds[k] = ("case", [row[k]] * n)
+    from beadsim.compare import EXPERIMENT_PARAMS
+    for k in EXPERIMENT_PARAMS:
+        if k not in ds:
+            ds[k] = ("case", [row[k]] * n)
+    t = speed_accuracy_table(ds, experiments).set_index("run_id")
+    assert t.loc["fine", "error_table1"] == pytest.approx(0.0, abs=1e-12)
+    assert t.loc["coarse", "error_table1"] == pytest.approx(0.5 * (0.1 + 0.1))
+    assert (t["reference"].iloc[:3] == "fine").all()  # the failed finer run is not the reference
+    assert t.loc["red", "error_reference"] == pytest.approx(0.5 * (4.0 / 3.3 - 1 + 0.5))
+    assert np.isnan(t.loc["bad", "error_table1"])
+    assert list(t["pareto_table1"]) == [True, True, True, False]

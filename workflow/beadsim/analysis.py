@@ -184,11 +184,13 @@ STABILITY_CLASSES = ("stable", "degraded", "blown_up")
 
 
 def stability_class(status: str, density_min: float, density_max: float, energy_error: float,
-                    density_band: float = 0.05, energy_band: float = 0.02) -> str:
-    """Classify one run: ``blown_up`` (the watchdog stopped it), ``degraded`` (it held, but the liquid density
-    left rho0 +- density_band or the energy balance is off by more than energy_band), ``stable`` otherwise."""
+                    density_band: float = 0.05, energy_band: float = 0.02, reason: str = "") -> str:
+    """Classify one run: ``error`` (it failed for a reason that is not numerical: a Python exception, reason
+    starting with ``error:``), ``blown_up`` (the watchdog or LAMMPS stopped it), ``degraded`` (it held, but the
+    liquid density left rho0 +- density_band or the energy balance is off by more than energy_band),
+    ``stable`` otherwise."""
     if status != "ok":
-        return "blown_up"
+        return "error" if str(reason).startswith("error:") else "blown_up"
     dens_ok = (not np.isfinite(density_min) or density_min >= 1 - density_band) and \
         (not np.isfinite(density_max) or density_max <= 1 + density_band)
     energy_ok = not np.isfinite(energy_error) or abs(energy_error) <= energy_band
@@ -217,6 +219,53 @@ def stability_table(ds: xr.Dataset, density_band: float = 0.05, energy_band: flo
         df[k] = ds[k].values
     df["status"] = ds["status"].values
     df["reason"] = ds["reason"].values
-    df["class"] = [stability_class(s, a, b, e, density_band, energy_band) for s, a, b, e in
-                   zip(df["status"], df["density_min"], df["density_max"], df["energy_balance_error"])]
+    df["class"] = [stability_class(s, a, b, e, density_band, energy_band, r) for s, a, b, e, r in
+                   zip(df["status"], df["density_min"], df["density_max"], df["energy_balance_error"],
+                       df["reason"])]
+    return df
+
+
+def speed_accuracy_table(ds: xr.Dataset, exp: pd.DataFrame, reference: str | None = None) -> pd.DataFrame:
+    """Cost and error of every run, for a speed-vs-accuracy (Pareto) chart.
+
+    Cost: the job's wall time (Snakemake benchmark, ``job_wall_time_s``; else the model's ``wall_time_s``).
+    Error versus Table 1: mean of |relative error| of bead width and height, for runs that match a measured mode.
+    Error versus the reference: the same against a reference run of the same mode -- ``reference`` (a run id) or,
+    by default, the successful SPH run with the smallest ``resolution_mm`` for that mode (ties: the most
+    expensive). Failed runs keep their cost and get no error. ``pareto_table1`` / ``pareto_reference`` flag the
+    runs no other run beats in both cost and error.
+    """
+    matched = match_experiments(ds, exp)
+    cases = [str(c) for c in ds["case"].values]
+    cost_var = "job_wall_time_s" if "job_wall_time_s" in ds else "wall_time_s"
+    df = pd.DataFrame({
+        "run_id": cases, "model": ds["model"].values.astype(str), "status": ds["status"].values.astype(str),
+        "resolution_mm": ds["resolution_mm"].values.astype(float),
+        "mode": [matched.get(c, np.nan) for c in cases],
+        "cost_s": ds[cost_var].values.astype(float),
+        "width_mm": ds["bead_width_mm"].values.astype(float),
+        "height_mm": ds["bead_height_mm"].values.astype(float)})
+    for opt in ("domain", "stop_at_steady_state", "n_particles", "n_steps"):
+        if opt in ds:
+            df[opt] = ds[opt].values
+    ok = df["status"] == "ok"
+    meas_w = df["mode"].map(lambda m: exp.loc[int(m), "bead_width_mm"] if np.isfinite(m) else np.nan)
+    meas_h = df["mode"].map(lambda m: exp.loc[int(m), "bead_height_mm"] if np.isfinite(m) else np.nan)
+    df["error_table1"] = np.where(ok, 0.5 * (abs(df["width_mm"] / meas_w - 1) + abs(df["height_mm"] / meas_h - 1)),
+                                  np.nan)
+    df["reference"] = ""
+    df["error_reference"] = np.nan
+    for mode, grp in df[df["mode"].notna()].groupby("mode"):
+        if reference and reference in set(grp["run_id"]):
+            ref = grp.loc[grp["run_id"] == reference].iloc[0]
+        else:
+            cand = grp[(grp["model"] == "sph") & (grp["status"] == "ok") & grp["width_mm"].notna()]
+            if cand.empty:
+                continue
+            ref = cand.sort_values(["resolution_mm", "cost_s"], ascending=[True, False]).iloc[0]
+        err = 0.5 * (abs(grp["width_mm"] / ref["width_mm"] - 1) + abs(grp["height_mm"] / ref["height_mm"] - 1))
+        df.loc[grp.index, "reference"] = ref["run_id"]
+        df.loc[grp.index, "error_reference"] = np.where(grp["status"] == "ok", err, np.nan)
+    df["pareto_table1"] = pareto_front(df["cost_s"], df["error_table1"])
+    df["pareto_reference"] = pareto_front(df["cost_s"], df["error_reference"])
     return df

@@ -36,6 +36,7 @@ METRICS: dict[str, tuple[str, str]] = {
     "steady_state_time_s": ("s", "time steady state was detected"),
     "particle_steps_per_s": ("s-1", "particle-steps per second"),
     "python_time_share": ("1", "share of wall time outside LAMMPS"),
+    "python_time_share_bead_checks": ("1", "share of wall time spent in bead cross-section checks (window)"),
     "mpi_ranks": ("1", "MPI ranks of the run"),
     "wall_time_s": ("s", "wall time of the model"),
     "density_min": ("1", "minimum liquid density / rho0"),

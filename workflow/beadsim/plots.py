@@ -238,7 +238,7 @@ def convergence_plot(ds: xr.Dataset, table: pd.DataFrame, parameter: str) -> plt
     return fig
 
 
-STABILITY_COLORS = {"stable": "tab:green", "degraded": "tab:orange", "blown_up": "tab:red"}
+STABILITY_COLORS = {"stable": "tab:green", "degraded": "tab:orange", "blown_up": "tab:red", "error": "tab:gray"}
 
 
 def stability_map(ds: xr.Dataset, table: pd.DataFrame, x: str | None, y: str | None,
@@ -263,6 +263,32 @@ def stability_map(ds: xr.Dataset, table: pd.DataFrame, x: str | None, y: str | N
         if y:
             ax.set_ylabel(label(ds[y]))
         ax.set_title(f"{facet} = {fv}" if fv is not None else "", fontsize=9)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def speed_accuracy_plot(table: pd.DataFrame) -> plt.Figure:
+    """Wall time against error (versus Table 1 and versus the reference run), Pareto fronts joined."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), squeeze=False)
+    for ax, (col, flag, title) in zip(axes[0], (("error_table1", "pareto_table1", "error vs Table 1"),
+                                                 ("error_reference", "pareto_reference", "error vs reference run"))):
+        sub = table[np.isfinite(table[col]) & np.isfinite(table["cost_s"])]
+        for model, part in sub.groupby("model"):
+            ax.scatter(part["cost_s"], 100 * part[col], s=50, label=model, edgecolors="k")
+        front = sub[sub[flag]].sort_values("cost_s")
+        ax.plot(front["cost_s"], 100 * front[col], "k--", lw=1, label="Pareto front")
+        for _, r in sub.iterrows():
+            ax.annotate(r["run_id"], (r["cost_s"], 100 * r[col]), fontsize=6, xytext=(3, 3),
+                        textcoords="offset points")
+        failed = table[table["status"] != "ok"]
+        for _, r in failed.iterrows():
+            if np.isfinite(r["cost_s"]):
+                ax.axvline(r["cost_s"], color="tab:red", lw=0.6, ls=":")
+        ax.set_xscale("log")
+        ax.set_xlabel("wall time of the run, s (log)")
+        ax.set_ylabel("mean |relative error| of width and height, %")
+        ax.set_title(title + (" (red dotted: failed runs)" if len(failed) else ""), fontsize=9)
         ax.legend(fontsize=7)
     fig.tight_layout()
     return fig

@@ -144,6 +144,13 @@ def build_schema() -> dict:
                         "description": "Richardson extrapolation and GCI over a resolution ladder",
                         "properties": {"parameter": {"enum": numeric, "default": "resolution_mm"}},
                     },
+                    "speed_accuracy": {
+                        "type": "object",
+                        "additionalProperties": False,
+                        "description": "wall time against error (vs Table 1 and vs a reference run), Pareto fronts",
+                        "properties": {"reference": {"type": "string", "description": "run id of the reference "
+                                                     "(default: the finest successful SPH run of each mode)"}},
+                    },
                 },
             },
             "report": {

@@ -77,3 +77,30 @@ rule analyze_stability:
         f"logs/{STUDY}/analyze_stability.log",
     script:
         "../scripts/analyze_stability.py"
+
+
+rule analyze_speed_accuracy:
+    input:
+        dataset=f"{OUT}/dataset.nc",
+        experiments=EXPERIMENTS_FILE,
+    output:
+        table=report(
+            f"{OUT}/speed_accuracy/table.csv",
+            caption="../report/speed_accuracy.rst",
+            category="Speed vs accuracy",
+            labels={"table": "cost and error per run"},
+        ),
+        figure=report(
+            f"{OUT}/speed_accuracy/pareto.png",
+            caption="../report/speed_accuracy.rst",
+            category="Speed vs accuracy",
+            labels={"figure": "Pareto chart"},
+        ),
+    params:
+        reference=lookup(dpath="analysis/speed_accuracy/reference", within=config, default=""),
+    conda:
+        "../../envs/beadsim.yaml"
+    log:
+        f"logs/{STUDY}/analyze_speed_accuracy.log",
+    script:
+        "../scripts/analyze_speed_accuracy.py"

@@ -59,6 +59,8 @@ def get_final_output():
         extra += [f"{OUT}/calibration/leave_one_out.csv", f"{OUT}/calibration/curves.png"]
     if "stability" in analyses:
         extra += [f"{OUT}/stability/classes.csv", f"{OUT}/stability/stability_map.png"]
+    if "speed_accuracy" in analyses:
+        extra += [f"{OUT}/speed_accuracy/table.csv", f"{OUT}/speed_accuracy/pareto.png"]
     if "convergence" in analyses:
         extra += [f"{OUT}/convergence/richardson.csv", f"{OUT}/convergence/convergence.png"]
     sph_runs = [r for r in RUN_IDS if DESIGN.loc[r, "model"] == "sph"]

@@ -360,10 +360,13 @@ class Ledger:
     evaporated: float = 0.0
     boundary: float = 0.0
     initial: float = 0.0
+    advected_in: float = 0.0
+    advected_out: float = 0.0
 
     def residual(self, now: float) -> float:
         """Energy present minus what the ledger says should be present (J)."""
-        return now - (self.initial + self.beam + self.volumetric + self.wire_in - self.evaporated - self.boundary)
+        return now - (self.initial + self.beam + self.volumetric + self.wire_in - self.evaporated - self.boundary
+                      + self.advected_in - self.advected_out)
 
 
 @dataclass
@@ -382,6 +385,8 @@ class RunState:
     rho_max: float = 1.0
     t_max: float = 0.0
     v_max: float = 0.0
+    inflow_x: float = float("nan")
+    n_advected_out: int = 0
 
 
 class PerId:
@@ -391,13 +396,15 @@ class PerId:
     def __init__(self, n: int):
         self.max_t = np.zeros(n + 1)
         self.face_area = np.zeros(n + 1)
+        self.wire_origin = np.zeros(n + 1, dtype=bool)
 
     def grow(self, n: int) -> None:
-        """Make room for ids up to n."""
+        """Make room for ids up to n (with headroom, ids only grow)."""
         if n + 1 > len(self.max_t):
-            extra = n + 1 - len(self.max_t)
+            extra = max(n + 1 - len(self.max_t), len(self.max_t) // 4)
             self.max_t = np.concatenate([self.max_t, np.zeros(extra)])
             self.face_area = np.concatenate([self.face_area, np.zeros(extra)])
+            self.wire_origin = np.concatenate([self.wire_origin, np.zeros(extra, dtype=bool)])
 
 
 # ----------------------------------------------------------------------------------------------- driver
@@ -417,6 +424,8 @@ class BeadRun:
         self.series: list[dict] = []
         self.per_id = PerId(0)
         self.lammps_time = 0.0
+        self.bead_time = 0.0
+        self.profiles: list = []  # (y, h) of the last bead sections (moving window)
         self.particle_steps = 0.0
         self.t_end = params["sim_time_s"]
         self.chunk = int(params["chunk_steps"])
@@ -466,6 +475,9 @@ class BeadRun:
         cmd(f"set type {TYPE_SUBSTRATE} sph/rho {self.mat.rho:.9g}")
         cmd(f"set type {TYPE_SUBSTRATE} sph/cv {self.thermal.heat_capacity:.9g}")
         cmd(f"set type {TYPE_SUBSTRATE} sph/e {self.thermal.energy(self.T0):.9g}")
+        if g.moving_window:
+            cmd(f"velocity all set {g.substrate_velocity[0]:.9g} 0 0 units box")
+            self.state.inflow_x = g.x_hi - d / 2
         self.state.next_id = n_sub + 1
         wire, s_last = scene.initial_wire(g)
         self.state.wire_s_last = s_last
@@ -491,6 +503,7 @@ class BeadRun:
         self.state.next_id = last + 1
         self.per_id.grow(last)
         self.per_id.max_t[first:last + 1] = self.T0
+        self.per_id.wire_origin[first:last + 1] = True
         m = self.num.mass
         self.state.ledger.wire_in += len(pos) * (e0 + 0.5 * m * float(v @ v)) + m * GRAVITY * float(pos[:, 2].sum())
 
@@ -530,6 +543,8 @@ class BeadRun:
         else:  # cohesion acts by type: melt and freeze at chunk ends, when the types switch
             cmd(f"variable frozen atom type!={TYPE_LIQUID}")
         cmd("group frozen dynamic all var frozen every 1")
+        if self.geom.moving_window and not self.lmp.has_id("region", "behind"):
+            cmd(f"region behind block INF {self.geom.x_lo:.9g} INF INF INF INF units box")
         cmd("fix integrate all sph")
         cmd(f"fix gravity all gravity {GRAVITY} vector 0 0 -1")
         cmd("fix freeze frozen setforce 0.0 0.0 0.0")
@@ -603,6 +618,50 @@ class BeadRun:
             created = True
         return created
 
+    def _advect_window(self) -> bool:
+        """Moving window: create the substrate layers that entered through the front face since the last call
+        and delete everything that left through the rear face; both carry their energy (internal, kinetic,
+        potential) into the ledger. True if atoms were created or deleted."""
+        g, st, d = self.geom, self.state, self.geom.dx
+        if not g.moving_window:
+            return False
+        created = False
+        m = self.num.mass
+        vel = g.substrate_velocity
+        e0 = self.thermal.energy(self.T0)
+        while st.inflow_x + d <= g.x_hi - d / 2 + 1e-12:
+            st.inflow_x += d
+            pos = scene.substrate_layer(g, st.inflow_x)
+            n, first = len(pos), st.next_id
+            ids = np.arange(first, first + n)
+            self.lmp.create_atoms(n, ids.tolist(), [TYPE_SUBSTRATE] * n, pos.ravel().tolist(),
+                                  np.tile(vel, n).tolist())
+            self.deck.note(f"created substrate layer x = {st.inflow_x:.6g} m, ids {first}-{first + n - 1}")
+            self.deck(f"set atom {first}*{first + n - 1} sph/rho {self.mat.rho:.9g} "
+                      f"sph/cv {self.thermal.heat_capacity:.9g} sph/e {e0:.9g}")
+            st.next_id = first + n
+            self.per_id.grow(st.next_id)
+            self.per_id.max_t[ids] = self.T0
+            self.per_id.face_area[ids] = scene.face_areas(g, pos)
+            st.ledger.advected_in += n * (e0 + 0.5 * m * float(vel @ vel)) + m * GRAVITY * float(pos[:, 2].sum())
+            created = True
+        if not created:
+            return False
+        x, v, e, types = self._x(), self._v(), self._e(), self._types()
+        out = x[:, 0] < g.x_lo
+        n_liquid = allreduce(self.lmp, int((out & (types == TYPE_LIQUID)).sum()))
+        if n_liquid:
+            raise SimulationFailed(f"{n_liquid} molten particles reached the rear face of the moving window at "
+                                   f"t={st.t:.4g} s: the pool is longer than the window (raise window_bead_mm)",
+                                   self._metrics(partial=True))
+        energy = float(e[out].sum() + 0.5 * m * np.einsum("ij,ij->", v[out], v[out]) + m * GRAVITY * x[out, 2].sum())
+        st.ledger.advected_out += allreduce(self.lmp, energy)
+        n_out = allreduce(self.lmp, int(out.sum()))
+        if n_out:
+            st.n_advected_out += n_out
+            self.deck("delete_atoms region behind compress no")
+        return True
+
     def _phase_update(self) -> tuple[np.ndarray, bool]:
         """Temperatures, types, frozen velocities and densities after a chunk.
 
@@ -623,7 +682,7 @@ class BeadRun:
         changed = allreduce(self.lmp, int((new_types != types).sum())) > 0
         types[:] = new_types
         frozen = ~liquid
-        target = np.where(types[frozen, None] == TYPE_WIRE, self.geom.wire_velocity, 0.0)
+        target = np.where(types[frozen, None] == TYPE_WIRE, self.geom.wire_velocity, self.geom.substrate_velocity)
         # kinetic energy removed by freezing a particle in place becomes heat of that particle
         ke_old = 0.5 * self.num.mass * np.einsum("ij,ij->i", v[frozen], v[frozen])
         ke_new = 0.5 * self.num.mass * np.einsum("ij,ij->i", target, target)
@@ -714,7 +773,10 @@ class BeadRun:
             removed = e[on_face] - e0
         else:
             t_eff = max(self.state.t, dt_chunk)
-            length = math.sqrt(math.pi * self.mat.diffusivity * t_eff)
+            if self.geom.moving_window:  # exposure time of the face particle: since it entered the window
+                x_in = self._x()[on_face, 0]
+                t_eff = np.clip((self.geom.x_hi - x_in) / self.geom.substrate_speed, dt_chunk, t_eff)
+            length = np.sqrt(math.pi * self.mat.diffusivity * t_eff)
             flux = self.mat.k * (temp[on_face] - self.T0) / length * area[on_face] * dt_chunk
             removed = np.minimum(flux, e[on_face] - e0)  # never below the far-field temperature
         e[on_face] -= removed
@@ -751,7 +813,8 @@ class BeadRun:
         m.update(self._energy_now())
         led = st.ledger
         m.update(E_beam=led.beam, E_volumetric=led.volumetric, E_wire_in=led.wire_in,
-                 E_evaporated=led.evaporated, E_boundary=led.boundary)
+                 E_evaporated=led.evaporated, E_boundary=led.boundary, E_advected_in=led.advected_in,
+                 E_advected_out=led.advected_out)
         now = m["E_internal"] + m["E_kinetic"] + m["E_potential"] + m.get("E_cohesion", 0.0)
         m["E_residual"] = led.residual(now)
         e_in = led.beam + led.volumetric
@@ -759,6 +822,8 @@ class BeadRun:
         xl = self._x()[liquid, 0]
         m["pool_x_min"] = allreduce(lmp, float(xl.min()) if liquid.any() else np.inf, "min")
         m["pool_x_max"] = allreduce(lmp, float(xl.max()) if liquid.any() else -np.inf, "max")
+        yl = np.abs(self._x()[liquid, 1])
+        m["pool_y_abs_max"] = allreduce(lmp, float(yl.max()) if liquid.any() else 0.0, "max")
         zw = self._x()[self._types() == TYPE_WIRE, 2]
         m["wire_z_min"] = allreduce(lmp, float(zw.min()) if len(zw) else np.inf, "min")
         return m
@@ -771,6 +836,10 @@ class BeadRun:
             reason = f"non-finite position, velocity or energy {where}"
         elif m["n_atoms"] != expected_atoms:
             reason = f"{expected_atoms - m['n_atoms']} particles lost (left the box) {where}"
+        elif self.geom.moving_window and "y_hi" in self.geom.cut_faces and \
+                m["pool_y_abs_max"] > self.geom.y_hi - self.geom.dx:
+            reason = (f"melt reached the side face of the moving window (|y| {m['pool_y_abs_max'] * 1e3:.2f} mm of "
+                      f"{self.geom.y_hi * 1e3:.2f} mm) {where}: raise window_thermal_lengths")
         elif m["wire_z_min"] < -2 * self.geom.dx:
             reason = (f"solid wire reached {-m['wire_z_min'] * 1e3:.2f} mm below the surface {where}: the beam "
                       "does not melt the wire as fast as it is fed (stubbing)")
@@ -801,8 +870,10 @@ class BeadRun:
         wall_block = time.perf_counter()
         steps_block = 0
         m = None
+        bead_every = 5 * block  # bead cross-section checks every ~0.05 s (moving window)
         while st.t < self.t_end - 0.5 * dt_chunk:
             need_setup |= self._feed_wire()
+            need_setup |= self._advect_window()
             bx = self.geom.beam_x(st.t)
             st.ledger.beam += deposit_beam(
                 self.lmp, p, self.geom, self._x(), self._e(), power * dt_chunk, bx, st.t, st.t + dt_chunk)
@@ -816,6 +887,7 @@ class BeadRun:
             self.lammps_time += time.perf_counter() - t_lmp
             st.t += dt_chunk
             st.step += self.chunk
+            st.inflow_x -= self.geom.substrate_speed * dt_chunk  # NaN unless moving window
             st.steps_since_shepard += self.chunk
             self.particle_steps += natoms * self.chunk
             steps_block += self.chunk
@@ -833,6 +905,10 @@ class BeadRun:
             st.rho_min, st.rho_max = min(st.rho_min, m["rho_min"]), max(st.rho_max, m["rho_max"])
             st.t_max, st.v_max = max(st.t_max, m["T_max"]), max(st.v_max, m["v_max"])
             if chunks % block == 0:
+                if self.geom.moving_window and chunks % bead_every == 0:
+                    t_bead = time.perf_counter()
+                    m.update(self._bead_check())
+                    self.bead_time += time.perf_counter() - t_bead
                 now = time.perf_counter()
                 m["steps_per_s"] = steps_block / (now - wall_block)
                 wall_block, steps_block = now, 0
@@ -851,6 +927,19 @@ class BeadRun:
         self._write_series()
         return self._metrics()
 
+    def _bead_check(self) -> dict:
+        """Bead cross-section now (moving window), for the steady-state test and the final average."""
+        keys = ("bead_width_mm", "bead_height_mm", "bead_area_mm2", "contact_angle_deg", "mass_balance_ratio",
+                "penetration_depth_mm")
+        out = self._bead_metrics(self._supply_mm2())
+        if "profile" in out:
+            self.profiles = (self.profiles + [out["profile"]])[-3:]
+        return {k: float(out.get(k, np.nan)) for k in keys}
+
+    def _supply_mm2(self) -> float:
+        p = self.p
+        return math.pi * (p["wire_diameter_mm"] / 2) ** 2 * p["wire_feed_mm_s"] / p["substrate_speed_mm_s"]
+
     def _report(self, m: dict) -> None:
         info = {"t": m["t"], "steps_per_s": m["steps_per_s"], "T_max": m["T_max"], "n_liquid": m["n_liquid"],
                 "energy_error": m["energy_error"], "rho_min": m["rho_min"], "rho_max": m["rho_max"],
@@ -861,16 +950,26 @@ class BeadRun:
         if self.progress:
             self.progress(info)
 
-    def _steady(self, window: float = 0.2, tol: float = 0.05) -> bool:
-        """Record the first time the pool is steady: the means of the melt count and of the pool length over
-        the last ``window`` seconds differ from those over the window before by less than ``tol``.
+    def _steady(self, window: float = 0.2) -> bool:
+        """Record the first time the run is steady: the means of the melt count and of the pool length over
+        the last ``window`` seconds differ from those over the window before by less than ``steady_tolerance``;
+        in the moving window also the mass balance of the last three bead cross-sections (0.05 s apart) lies
+        within that tolerance of 1: the bead leaving the window carries the metal the wire brings (the
+        width of a bead one or two particles thick jumps by whole spacings from one section to the next, so
+        it is no criterion; it is taken from the mean height profile of the last sections instead).
 
         Means, not ranges: dripping wire makes the instantaneous values fluctuate by 10-30 %. T_max is no
         criterion: with the boiling cap it sits at T_boil from the first tenths of a second.
         """
         st = self.state
+        tol = self.p["steady_tolerance"]
         if math.isfinite(st.steady_time):
             return True
+        if self.geom.moving_window:  # mass steady: the bead leaving carries what the wire brings
+            ratio = np.array([c.get("mass_balance_ratio", np.nan) for c in self.series
+                              if "mass_balance_ratio" in c][-3:], dtype=float)
+            if len(ratio) < 3 or not (np.abs(ratio - 1) < tol).all():
+                return False
         if st.t < max(2 * beam_footprint_radius(self.p) / self.geom.substrate_speed, 2 * window):
             return False
         t = np.array([m["t"] for m in self.series])
@@ -891,12 +990,14 @@ class BeadRun:
     def _write_series(self) -> None:
         if not self.series or not hasattr(self, "lmp") or not is_rank0(self.lmp):
             return
-        keys = [k for k in self.series[0] if k not in ("t", "finite")]
+        keys = [k for k in dict.fromkeys(k for m in self.series for k in m) if k not in ("t", "finite")]
         ds = xr.Dataset({k: ("time", np.array([m.get(k, np.nan) for m in self.series], dtype=float))
                          for k in keys},
                         coords={"time": ("time", np.array([m["t"] for m in self.series]), {"units": "s"})})
         units = {"T_max": "K", "rho_min": "1", "rho_max": "1", "v_max": "m s-1", "steps_per_s": "s-1",
-                 "pool_x_min": "m", "pool_x_max": "m", "energy_error": "1"}
+                 "pool_x_min": "m", "pool_x_max": "m", "energy_error": "1", "bead_width_mm": "mm",
+                 "bead_height_mm": "mm", "bead_area_mm2": "mm2", "contact_angle_deg": "degree",
+                 "penetration_depth_mm": "mm"}
         for k in ds.data_vars:
             ds[k].attrs["units"] = "J" if k.startswith("E_") else units.get(k, "1")
         ds["t"] = ds["time"]
@@ -913,7 +1014,8 @@ class BeadRun:
             return
         os.replace(rdir / "restart.tmp.bin", rdir / "restart.bin")
         np.savez(rdir / "state.tmp.npz", state=json.dumps(asdict(self.state)), max_t=max_t,
-                 face_area=self.per_id.face_area, series=json.dumps(self.series),
+                 face_area=self.per_id.face_area, wire_origin=self.per_id.wire_origin,
+                 series=json.dumps(self.series),
                  particle_steps=self.particle_steps)
         os.replace(rdir / "state.tmp.npz", rdir / "state.npz")
 
@@ -925,6 +1027,8 @@ class BeadRun:
         self.state = RunState(**raw)
         self.per_id.max_t = np.array(data["max_t"])
         self.per_id.face_area = np.array(data["face_area"])
+        self.per_id.wire_origin = np.array(data["wire_origin"]) if "wire_origin" in data else \
+            np.zeros(len(self.per_id.max_t), dtype=bool)
         self.series = json.loads(str(data["series"]))
         self.particle_steps = float(data["particle_steps"])
         self.deck.note(f"resume from checkpoint at t = {self.state.t:.6g} s, step {self.state.step}")
@@ -933,12 +1037,15 @@ class BeadRun:
 
     # ---- metrics
     def _gather(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Global positions (N,3), types and ids sorted by id (all ranks)."""
+        """Global positions (N,3), types and ids sorted by id (all ranks; ids need not be consecutive, as in
+        the moving window where particles are deleted)."""
         n = int(self.lmp.get_natoms())
-        x = np.ctypeslib.as_array(self.lmp.gather_atoms("x", 1, 3), shape=(n * 3,)).reshape(n, 3).copy()
-        types = np.ctypeslib.as_array(self.lmp.gather_atoms("type", 0, 1), shape=(n,)).copy()
-        ids = np.ctypeslib.as_array(self.lmp.gather_atoms("id", 0, 1), shape=(n,)).copy()
-        return x, types, ids
+        gather = self.lmp.gather_atoms_concat
+        x = np.ctypeslib.as_array(gather("x", 1, 3), shape=(n * 3,)).reshape(n, 3).copy()
+        types = np.ctypeslib.as_array(gather("type", 0, 1), shape=(n,)).copy()
+        ids = np.ctypeslib.as_array(gather("id", 0, 1), shape=(n,)).copy()
+        order = np.argsort(ids)
+        return x[order], types[order], ids[order]
 
     def _metrics(self, partial: bool = False) -> dict:
         p, st, num = self.p, self.state, self.num
@@ -955,18 +1062,36 @@ class BeadRun:
                "evaporated_energy_J": st.ledger.evaporated, "boundary_heat_loss_J": st.ledger.boundary,
                "absorbed_power_W": p["beam_power_W"] * p["beam_efficiency"]}
         area_w = math.pi * (p["wire_diameter_mm"] / 2) ** 2
-        out["wire_supply_area_mm2"] = area_w * p["wire_feed_mm_s"] / p["substrate_speed_mm_s"]
+        out["wire_supply_area_mm2"] = self._supply_mm2()
+        out["python_time_share_bead_checks"] = self.bead_time / wall if wall > 0 else np.nan
         out["wire_melt_power_W"] = (self.mat.rho * area_w * 1e-6 * p["wire_feed_mm_s"] * 1e-3
                                     * (self.mat.cp * (self.mat.T_melt - self.T0) + self.mat.latent_heat))
         if not partial:
             out.update(self._bead_metrics(out["wire_supply_area_mm2"]))
+            checks = [m for m in self.series if np.isfinite(m.get("mass_balance_ratio", np.nan))][-3:]
+            if self.geom.moving_window and checks and self.profiles:
+                # steady state: the mean of the last three cross-sections (0.05 s apart)
+                from beadsim.sph import surface
+
+                out.pop("profile", None)
+                for key in ("mass_balance_ratio", "penetration_depth_mm"):
+                    out[key] = float(np.nanmean([c.get(key, np.nan) for c in checks]))
+                y = self.profiles[-1][0]
+                same = [h for yy, h in self.profiles if len(yy) == len(y) and np.allclose(yy, y)]
+                with np.errstate(all="ignore"):
+                    out.update(surface.profile_metrics(y, np.nanmean(same, axis=0), self.num.dx))
+                if out.get("bead_width_mm"):
+                    out["aspect_ratio"] = out["bead_height_mm"] / out["bead_width_mm"]
+                log.info("bead: mean profile of the sections at t = %s s", ", ".join(f"{c['t']:.3f}" for c in checks))
+            out.pop("profile", None)
         return out
 
     def _bead_metrics(self, supply_mm2: float) -> dict:
         """Bead cross-section, pool and penetration from the final state (see :func:`reduce_bead`)."""
         x, types, ids = self._gather()
         max_t = allreduce(self.lmp, self.per_id.max_t, "max")
-        return reduce_bead(x, types, max_t[ids] >= self.mat.T_melt, self.geom, self.p, self.state.t, supply_mm2)
+        return reduce_bead(x, types, max_t[ids] >= self.mat.T_melt, self.geom, self.p, self.state.t, supply_mm2,
+                           wire_origin=self.per_id.wire_origin[ids])
 
 
 def bead_window(geom: SceneGeometry, params: dict, t: float, pool_x_min: float) -> tuple[float, float] | None:
@@ -978,20 +1103,24 @@ def bead_window(geom: SceneGeometry, params: dict, t: float, pool_x_min: float) 
     """
     r_fp, d = beam_footprint_radius(params), geom.dx
     end = min(pool_x_min, geom.beam_x(t) - r_fp) - d
-    start = max(geom.beam_x(0.0) + r_fp, end - 2e-3)
-    # snap to the substrate lattice cells, so that the window holds whole columns of the initial lattice
-    start = geom.x_lo + math.ceil((start - geom.x_lo) / d - 1e-9) * d
-    end = geom.x_lo + math.floor((end - geom.x_lo) / d + 1e-9) * d
+    if geom.moving_window:  # beam frame: the lattice moves, so no snapping; stay clear of the rear face
+        start = max(geom.deposited_x_min(t, r_fp), geom.x_lo + d, end - params["window_bead_mm"] * 1e-3)
+    else:
+        start = max(geom.deposited_x_min(t, r_fp), end - 2e-3)
+        # snap to the substrate lattice cells, so that the window holds whole columns of the initial lattice
+        start = geom.x_lo + math.ceil((start - geom.x_lo) / d - 1e-9) * d
+        end = geom.x_lo + math.floor((end - geom.x_lo) / d + 1e-9) * d
     return (start, end) if end - start >= 2 * d - 1e-12 else None
 
 
 def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: SceneGeometry, params: dict,
-                t: float, supply_mm2: float) -> dict:
+                t: float, supply_mm2: float, wire_origin: np.ndarray | None = None) -> dict:
     """Bead metrics from particle positions (m), types and ever-molten flags.
 
     The net added area (mass balance) counts every particle in the window slab minus the substrate particles
-    it held at t = 0, so it is exact in mass. Width, height, contact angle, pool and penetration come from
-    :mod:`beadsim.sph.surface`.
+    it held at t = 0, so it is exact in mass; in the moving window (the lattice moves through the slab) it
+    counts the particles that came from the wire (``wire_origin``). Width, height, contact angle, pool and
+    penetration come from :mod:`beadsim.sph.surface`.
     """
     from beadsim.sph import surface
 
@@ -1006,13 +1135,20 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
         return out
     deposit = types != TYPE_WIRE
     in_win = (x[:, 0] >= window[0]) & (x[:, 0] < window[1]) & deposit
-    n_cells = round((window[1] - window[0]) / geom.dx)
-    length = n_cells * geom.dx
-    nx, ny, nz = geom.counts()
-    n_before = n_cells * ny * nz
-    net_area = (int(in_win.sum()) - n_before) * geom.dx ** 3 / length * 1e6
+    if geom.moving_window:
+        length = window[1] - window[0]
+        in_slab = (x[:, 0] >= window[0]) & (x[:, 0] < window[1])
+        net_area = int((in_slab & wire_origin).sum()) * geom.dx ** 3 / length * 1e6
+    else:
+        n_cells = round((window[1] - window[0]) / geom.dx)
+        length = n_cells * geom.dx
+        nx, ny, nz = geom.counts()
+        n_before = n_cells * ny * nz
+        net_area = (int(in_win.sum()) - n_before) * geom.dx ** 3 / length * 1e6
     out["mass_balance_ratio"] = net_area / supply_mm2
-    out.update(surface.bead_cross_section(x[deposit], geom.dx, window, z_surface=0.0))
+    y_bins, top = surface.height_map(x[deposit], geom.dx, window, z_surface=0.0)
+    out.update(surface.profile_metrics(y_bins, top, geom.dx))
+    out["profile"] = (y_bins, top)
     out["penetration_depth_mm"] = surface.penetration_depth(x, melted, geom.dx, window, z_surface=0.0)
     if out.get("bead_width_mm"):
         out["aspect_ratio"] = out["bead_height_mm"] / out["bead_width_mm"]

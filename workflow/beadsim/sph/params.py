@@ -39,9 +39,17 @@ SPH_PARAMETERS: list[Param] = [
           "(zero flux, as in the paper), fixed (held at the preheat temperature). Faces that are real plate "
           "faces are insulated in every case", enum=("farfield", "insulated", "fixed"), short="bc",
           models=_SPH),
-    Param("domain", "string", "auto", "", "modelled substrate block: auto (sized from the case: travel, "
-          "scan diameter and domain_margin_mm, never larger than the plate) or plate (the whole "
-          "substrate_*_mm plate)", enum=("auto", "plate"), short="dom", models=_SPH),
+    Param("domain", "string", "auto", "", "modelled substrate block: auto (fixed block sized from the case: "
+          "travel, scan diameter and domain_margin_mm, never larger than the plate), plate (the whole "
+          "substrate_*_mm plate) or window (a block moving with the beam, sized from the thermal length; "
+          "substrate enters cold at the front, the bead leaves at the back)", enum=("auto", "plate", "window"),
+          short="dom", models=_SPH),
+    Param("window_thermal_lengths", "number", 2.0, "1", "domain window: margin ahead of and beside the beam "
+          "footprint in thermal lengths a / V_s", minimum=0.25, maximum=20, short="wL", models=_SPH,
+          long_name="window margin / thermal length"),
+    Param("window_bead_mm", "number", 1.5, "mm", "domain window: length of solid bead kept behind the melt "
+          "pool (the cross-section is averaged over it)", minimum=0.2, maximum=20, short="wB", models=_SPH,
+          long_name="window bead length"),
     Param("domain_margin_mm", "number", 3.0, "mm", "margin of the auto block around the scanned track and the "
           "wire", minimum=0.5, maximum=50, short="marg", models=_SPH, long_name="domain margin"),
     Param("domain_depth_mm", "number", 3.0, "mm", "thickness of the auto block (at most the plate thickness)",
@@ -55,8 +63,12 @@ SPH_PARAMETERS: list[Param] = [
           "(0 = never)", minimum=0, maximum=100000, short="shep", models=_SPH),
     Param("solid_density_reset", "boolean", True, "", "reset the density of frozen particles to rho0 every "
           "chunk", short="sdr", models=_SPH),
-    Param("stop_at_steady_state", "boolean", False, "", "stop before sim_time_s once T_max and the melt volume "
-          "are steady", short="ss", models=_SPH),
+    Param("stop_at_steady_state", "boolean", False, "", "stop before sim_time_s once the melt count and pool "
+          "length (and, in the window domain, the bead width and height) are steady within steady_tolerance",
+          short="ss", models=_SPH),
+    Param("steady_tolerance", "number", 0.05, "1", "relative change of the steady-state criteria allowed "
+          "between two successive averaging windows", exclusive_minimum=0, maximum=1, short="sstol",
+          models=_SPH, long_name="steady-state tolerance"),
     Param("chunk_steps", "integer", 10, "1", "time steps per LAMMPS run chunk (beam deposit, phase update and "
           "watchdog between chunks)", minimum=1, maximum=10000, short="chunk", models=_SPH),
     Param("dump_interval_s", "number", 0.05, "s", "process time between particle dumps", exclusive_minimum=0,

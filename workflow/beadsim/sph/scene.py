@@ -1,7 +1,10 @@
 """Particle scene of the SPH bead model: the substrate block and the wire.
 
 Frame: x is the travel direction, y across the bead, z up, the substrate top surface at z = 0, lengths in
-metres. The substrate is fixed; the beam axis and the wire move together at +V_s along x, starting at x = 0.
+metres. Two frames: ``domain`` auto/plate use the substrate frame (the substrate is fixed; the beam axis and
+the wire move together at +V_s along x, starting at x = 0); ``domain = window`` uses the beam frame (the beam
+axis stays at x = 0, the substrate moves at -V_s: it enters cold through the front face and the solid bead
+leaves through the rear face).
 The wire comes from the front (+x) and points down at ``wire_angle_deg``; its axis passes through the point
 (x_beam, 0, wire_height_mm) and its cut tip face lies in the plane through that point normal to the axis.
 Particles sit on a simple cubic lattice of spacing dx (substrate: cell centres, so the top layer is at -dx/2);
@@ -56,6 +59,17 @@ class SceneGeometry:
     wire_length: float
     substrate_speed: float
     wire_feed: float
+    frame: str = "substrate"
+
+    @property
+    def moving_window(self) -> bool:
+        """True in the beam frame (``domain = window``)."""
+        return self.frame == "beam"
+
+    @property
+    def substrate_velocity(self) -> np.ndarray:
+        """Velocity of solid substrate and bead, m/s: zero, or -V_s in the beam frame."""
+        return np.array([-self.substrate_speed if self.moving_window else 0.0, 0.0, 0.0])
 
     @property
     def wire_axis(self) -> np.ndarray:
@@ -64,12 +78,20 @@ class SceneGeometry:
 
     @property
     def wire_velocity(self) -> np.ndarray:
-        """Velocity of unmelted wire in the substrate frame, m/s: travel plus feed towards the tip."""
-        return np.array([self.substrate_speed, 0.0, 0.0]) - self.wire_feed * self.wire_axis
+        """Velocity of unmelted wire, m/s: feed towards the tip, plus travel in the substrate frame."""
+        return np.array([self.substrate_speed, 0.0, 0.0]) + self.substrate_velocity \
+            - self.wire_feed * self.wire_axis
 
     def beam_x(self, t: float) -> float:
         """x of the beam axis at process time t (s)."""
-        return self.substrate_speed * t
+        return 0.0 if self.moving_window else self.substrate_speed * t
+
+    def deposited_x_min(self, t: float, r_fp: float) -> float:
+        """Smallest x (m) of the track that passed under the beam at least r_fp / V_s after the start (the
+        start-up transient excluded)."""
+        if self.moving_window:
+            return -(self.substrate_speed * t - r_fp)
+        return r_fp
 
     def counts(self) -> tuple[int, int, int]:
         """Number of substrate lattice cells along x, y, z."""
@@ -89,7 +111,12 @@ def build_geometry(params: dict) -> SceneGeometry:
     ``domain = auto``: the block spans the scanned track over ``sim_time_s`` plus ``domain_margin_mm`` behind
     the start, ahead of the wire and on both sides, ``domain_depth_mm`` deep, each never larger than the plate.
     ``domain = plate``: the whole plate, with the start of the track ``domain_margin_mm`` plus the beam radius
-    from its rear end. Faces where the block is smaller than the plate are ``cut_faces``.
+    from its rear end. ``domain = window``: a block that moves with the beam (beam frame), sized from the
+    thermal length L = a / V_s of the case: ``window_thermal_lengths`` x L ahead of and beside the beam
+    footprint, behind it the melt-pool tail estimated by the reduced model's moving source
+    (:func:`pool_tail`) plus ``window_bead_mm`` of solid bead and two spacings; ``domain_depth_mm`` deep.
+    Faces where the block is smaller than the plate are ``cut_faces``; in the window the front (inflow, at
+    the preheat temperature) and rear (outflow) faces are not heat-loss faces.
     """
     mm = 1e-3
     dx = params["resolution_mm"] * mm
@@ -104,6 +131,23 @@ def build_geometry(params: dict) -> SceneGeometry:
     plate = (params["substrate_length_mm"] * mm, params["substrate_width_mm"] * mm,
              params["substrate_thickness_mm"] * mm)
     rear = _snap(beam_r + margin, dx)
+    frame = "substrate"
+    if params["domain"] == "window":
+        frame = "beam"
+        from beadsim.materials import get_material
+        mat = get_material(params["material"])
+        thermal = params["window_thermal_lengths"] * mat.diffusivity / vs
+        front = _snap(beam_r + thermal, dx)
+        rear = _snap(max(beam_r, pool_tail(params, mat)) + params["window_bead_mm"] * mm + 2 * dx, dx)
+        width = 2 * _snap(min(max(beam_r, radius) + thermal, plate[1] / 2), dx)
+        depth = _snap(min(params["domain_depth_mm"] * mm, plate[2]), dx)
+        top = height + wire_len * math.sin(alpha) + radius + 2 * dx
+        cut = ["y_lo", "y_hi"] if width < plate[1] - dx / 2 else []
+        cut += ["z_lo"] if depth < plate[2] - dx / 2 else []
+        return SceneGeometry(dx=dx, x_lo=-rear, x_hi=front, y_lo=-width / 2, y_hi=width / 2, z_lo=-depth,
+                             box_z_hi=top, cut_faces=tuple(cut), wire_radius=radius, wire_height=height,
+                             wire_angle=alpha, wire_length=wire_len, substrate_speed=vs,
+                             wire_feed=params["wire_feed_mm_s"] * mm, frame=frame)
     if params["domain"] == "plate":
         length, width, depth = _snap(plate[0], dx), 2 * _snap(plate[1] / 2, dx), _snap(plate[2], dx)
     else:
@@ -123,6 +167,37 @@ def build_geometry(params: dict) -> SceneGeometry:
                          box_z_hi=top, cut_faces=tuple(cut), wire_radius=radius, wire_height=height,
                          wire_angle=alpha, wire_length=wire_len, substrate_speed=vs,
                          wire_feed=params["wire_feed_mm_s"] * mm)
+
+
+def pool_tail(params: dict, mat) -> float:
+    """Distance (m) behind the beam axis where the surface centre line of the reduced model's quasi-steady
+    moving source (absorbed power less the wire's melting power, see :mod:`beadsim.reduced`) falls below the
+    melting temperature; 0 if nothing melts."""
+    from beadsim import reduced
+
+    mm = 1e-3
+    p_wire = reduced.wire_melt_power(mat, params["wire_diameter_mm"] * mm, params["wire_feed_mm_s"] * mm,
+                                     params["preheat_K"])
+    ring = params["scan_diameter_mm"] * mm / 2 if params["beam_profile"] in ("ring", "scan") else 0.0
+    src = reduced.MovingSource(Q=max(params["beam_power_W"] * params["beam_efficiency"] - p_wire, 0.0),
+                               V=params["substrate_speed_mm_s"] * mm, rho_c=mat.rho * mat.cp,
+                               alpha=mat.diffusivity, T0=params["preheat_K"],
+                               sigma=params["beam_spot_radius_mm"] * mm, ring_radius=ring,
+                               thickness=params["substrate_thickness_mm"] * mm)
+    if src.Q <= 0:
+        return 0.0
+    xs = -np.linspace(0.0, 0.05, 2001)
+    temp = src.temperature(np.column_stack([xs, np.zeros_like(xs), np.zeros_like(xs)]))
+    hot = np.flatnonzero(temp >= mat.T_melt)
+    return float(-xs[hot.max()]) if len(hot) else 0.0
+
+
+def substrate_layer(geom: SceneGeometry, x: float) -> np.ndarray:
+    """One y-z layer of the substrate lattice at x (m), shape (ny * nz, 3): what enters the window."""
+    _, ny, nz = geom.counts()
+    iy, iz = np.meshgrid(np.arange(ny), np.arange(nz), indexing="ij")
+    d = geom.dx
+    return np.column_stack([np.full(ny * nz, x), geom.y_lo + (iy.ravel() + 0.5) * d, -(iz.ravel() + 0.5) * d])
 
 
 def substrate_positions(geom: SceneGeometry) -> np.ndarray:

@@ -187,7 +187,13 @@ def bead_cross_section(pos, dx, x_window, z_surface=0.0, mask=None):
     dict
         ``bead_width_mm``, ``bead_height_mm``, ``bead_area_mm2``, ``contact_angle_deg`` (NaN where undefined).
     """
-    y, h = height_map(pos, dx, x_window, z_surface, mask)
+    return profile_metrics(*height_map(pos, dx, x_window, z_surface, mask), dx)
+
+
+def profile_metrics(y: np.ndarray, h: np.ndarray, dx: float) -> dict:
+    """Width, height, area and contact angle of a height profile h(y) (m) on bins of width dx, as in
+    :func:`bead_cross_section` (which applies it to one :func:`height_map`; the moving-window driver applies it
+    to the mean of several maps taken at different times)."""
     run = _bead_run(h, 0.5 * dx)
     n_bins = run.stop - run.start
     height = float(np.nanmax(h)) if n_bins else 0.0

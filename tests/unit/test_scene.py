@@ -1,0 +1,61 @@
+"""Scene geometry of the SPH model: the moving window against its sizing rules (no LAMMPS)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from beadsim.materials import get_material
+from beadsim.parameters import defaults
+from beadsim.sph import scene
+
+
+def window_case(**over) -> dict:
+    p = defaults()
+    p.update(model="sph", domain="window", resolution_mm=0.3, beam_power_W=1000.0, substrate_speed_mm_s=5.0,
+             wire_feed_mm_s=10.0, scan_diameter_mm=2.0)
+    p.update(over)
+    return p
+
+
+def test_window_is_sized_from_the_thermal_length():
+    p = window_case()
+    g = scene.build_geometry(p)
+    mat = get_material(p["material"])
+    thermal = p["window_thermal_lengths"] * mat.diffusivity / (p["substrate_speed_mm_s"] * 1e-3)
+    footprint = p["scan_diameter_mm"] * 1e-3 / 2 + 3 * p["beam_spot_radius_mm"] * 1e-3
+    dx = g.dx
+    assert g.moving_window and g.beam_x(0.7) == 0.0
+    assert footprint + thermal <= g.x_hi < footprint + thermal + dx + 1e-12
+    assert footprint + thermal <= g.y_hi < footprint + thermal + dx + 1e-12
+    tail = scene.pool_tail(p, mat)
+    assert -g.x_lo >= tail + p["window_bead_mm"] * 1e-3 + 2 * dx - 1e-12
+    assert "x_lo" not in g.cut_faces and "x_hi" not in g.cut_faces and "z_lo" in g.cut_faces
+    # a faster substrate: shorter thermal length, narrower window
+    assert scene.build_geometry(window_case(substrate_speed_mm_s=10.0)).y_hi < g.y_hi
+
+
+def test_pool_tail_grows_with_power_and_vanishes_without_melting():
+    mat = get_material("Ti-Gr2")
+    tails = [scene.pool_tail(window_case(beam_power_W=w), mat) for w in (600.0, 1000.0, 1400.0)]
+    assert 0 < tails[0] < tails[1] < tails[2] < 0.05
+    assert scene.pool_tail(window_case(beam_power_W=50.0), mat) == 0.0
+
+
+def test_beam_frame_velocities_and_inflow_layer():
+    g = scene.build_geometry(window_case())
+    assert np.allclose(g.substrate_velocity, [-g.substrate_speed, 0, 0])
+    assert np.allclose(g.wire_velocity, -g.wire_feed * g.wire_axis)  # no travel term in the beam frame
+    _, ny, nz = g.counts()
+    layer = scene.substrate_layer(g, 1e-3)
+    assert layer.shape == (ny * nz, 3) and np.allclose(layer[:, 0], 1e-3)
+    # the layer continues the lattice of the initial block in y and z
+    block = scene.substrate_positions(g)
+    assert np.allclose(np.unique(layer[:, 1]), np.unique(block[:, 1]))
+    assert np.allclose(np.unique(layer[:, 2]), np.unique(block[:, 2]))
+    fixed = scene.build_geometry(window_case(domain="auto"))
+    assert not fixed.moving_window and fixed.beam_x(0.2) == pytest.approx(0.2 * fixed.substrate_speed)
+    assert np.allclose(fixed.wire_velocity, [fixed.substrate_speed, 0, 0] - fixed.wire_feed * fixed.wire_axis)
+    assert math.isclose(scene.wire_slice_pitch(g), scene.wire_slice_pitch(fixed))
