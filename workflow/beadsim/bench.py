@@ -140,6 +140,9 @@ def main(argv: list[str] | None = None) -> dict:
                            "energy_balance_error": m.get("energy_balance_error"),
                            "python_time_share": m.get("python_time_share")}
             v = modes[mode]
+            if v["status"] != "ok":
+                print(f"    mode {mode}: failed after {v['wall_s']:.0f} s: {v['reason']}", flush=True)
+                continue
             print(f"    mode {mode}: {v['status']} {v['reason']}; wall {v['wall_s']:.0f} s "
                   f"({'within' if v['wall_s'] <= 600 else 'over'} 10 min), {v['n_particles']} particles, "
                   f"{v['n_steps']} steps to t = {v['simulated_time_s']:.3g} s (steady at "
@@ -152,8 +155,9 @@ def main(argv: list[str] | None = None) -> dict:
     if "plate" not in args.skip:
         full = args.full_plate
         t_plate = 2.0 if full else args.throughput_time
-        print(f"[3] whole plate at dx {args.dx} mm: {'full 2 s run' if full else f'{t_plate} s run, cost of 2 s '
-              'estimated as its particle-step rate x the particle-steps of 2 s'}", flush=True)
+        how = "full 2 s run" if full else (f"{t_plate} s run, cost of 2 s estimated as its particle-step rate x "
+                                           "the particle-steps of 2 s")
+        print(f"[3] whole plate at dx {args.dx} mm: {how}", flush=True)
         rec = run(mode_params(1, domain="plate", resolution_mm=args.dx, sim_time_s=t_plate,
                               restart_interval_s=60.0 if not full else 0.25, dump_interval_s=60.0 if not full else 0.05),
                   out / f"plate_dx{args.dx}_{t_plate}s", args.ranks, args.fresh)
@@ -168,6 +172,8 @@ def main(argv: list[str] | None = None) -> dict:
               f"{'measured' if full else 'estimated'} {wall_2s / 60:.0f} min for 2 s")
         if "modes" in report:
             for mode, v in report["modes"].items():
+                if v["status"] != "ok":
+                    continue
                 print(f"    mode {mode}: levers {v['wall_s']:.0f} s vs whole plate {wall_2s:.0f} s: "
                       f"{wall_2s / v['wall_s']:.1f}x faster")
 
@@ -180,6 +186,9 @@ def main(argv: list[str] | None = None) -> dict:
         win = run(mode_params(1, resolution_mm=args.ref_dx, **LEVERS), out / f"mode1_dx{args.ref_dx}",
                   args.ranks, args.fresh)
         a, b = ref["metrics"], win["metrics"]
+        for name, r in (("whole plate", ref), ("window", win)):
+            if r["status"] != "ok":
+                print(f"    {name} run failed: {r['reason']}")
         cmp_ = {"plate_wall_s": ref["elapsed_s"], "window_wall_s": win["elapsed_s"],
                 "speedup": ref["elapsed_s"] / win["elapsed_s"],
                 "plate_width_mm": a.get("bead_width_mm"), "plate_height_mm": a.get("bead_height_mm"),

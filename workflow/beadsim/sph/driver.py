@@ -629,16 +629,27 @@ class BeadRun:
         m = self.num.mass
         vel = g.substrate_velocity
         e0 = self.thermal.energy(self.T0)
+        n_before = int(self.lmp.get_natoms())
         while st.inflow_x + d <= g.x_hi - d / 2 + 1e-12:
             st.inflow_x += d
             pos = scene.substrate_layer(g, st.inflow_x)
             n, first = len(pos), st.next_id
             ids = np.arange(first, first + n)
-            self.lmp.create_atoms(n, ids.tolist(), [TYPE_SUBSTRATE] * n, pos.ravel().tolist(),
-                                  np.tile(vel, n).tolist())
-            self.deck.note(f"created substrate layer x = {st.inflow_x:.6g} m, ids {first}-{first + n - 1}")
+            # a lattice whose x origin puts one plane at inflow_x; create_atoms numbers the new atoms from the
+            # largest id + 1 (wire slices, created last, are never deleted, so that is next_id)
+            frac = (st.inflow_x - g.x_lo) / d % 1.0
+            self.deck(f"lattice sc {d:.9g} origin {frac:.9f} 0.5 0.5")
+            self.deck(f"region layer block {st.inflow_x - d / 2:.9g} {st.inflow_x + d / 2:.9g} {g.y_lo:.9g} "
+                      f"{g.y_hi:.9g} {g.z_lo:.9g} 0 units box")
+            self.deck(f"create_atoms {TYPE_SUBSTRATE} region layer")
+            self.deck("region layer delete")
             self.deck(f"set atom {first}*{first + n - 1} sph/rho {self.mat.rho:.9g} "
-                      f"sph/cv {self.thermal.heat_capacity:.9g} sph/e {e0:.9g}")
+                      f"sph/cv {self.thermal.heat_capacity:.9g} sph/e {e0:.9g} vx {vel[0]:.9g} vy 0 vz 0")
+            made = int(self.lmp.get_natoms()) - n_before
+            n_before += made
+            if made != n:
+                raise SimulationFailed(f"inflow layer at x = {st.inflow_x:.6g} m has {made} particles, expected {n}",
+                                       self._metrics(partial=True))
             st.next_id = first + n
             self.per_id.grow(st.next_id)
             self.per_id.max_t[ids] = self.T0
