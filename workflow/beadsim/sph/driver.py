@@ -848,7 +848,7 @@ class BeadRun:
         elif m["n_atoms"] != expected_atoms:
             reason = f"{expected_atoms - m['n_atoms']} particles lost (left the box) {where}"
         elif self.geom.moving_window and "y_hi" in self.geom.cut_faces and \
-                m["pool_y_abs_max"] > self.geom.y_hi - self.geom.dx:
+                m["pool_y_abs_max"] > self.geom.y_hi:
             reason = (f"melt reached the side face of the moving window (|y| {m['pool_y_abs_max'] * 1e3:.2f} mm of "
                       f"{self.geom.y_hi * 1e3:.2f} mm) {where}: raise window_thermal_lengths")
         elif m["wire_z_min"] < -2 * self.geom.dx:

@@ -44,7 +44,7 @@ SPH_PARAMETERS: list[Param] = [
           "substrate_*_mm plate) or window (a block moving with the beam, sized from the thermal length; "
           "substrate enters cold at the front, the bead leaves at the back)", enum=("auto", "plate", "window"),
           short="dom", models=_SPH),
-    Param("window_thermal_lengths", "number", 2.0, "1", "domain window: margin ahead of and beside the beam "
+    Param("window_thermal_lengths", "number", 3.0, "1", "domain window: margin ahead of and beside the beam "
           "footprint in thermal lengths a / V_s", minimum=0.25, maximum=20, short="wL", models=_SPH,
           long_name="window margin / thermal length"),
     Param("window_bead_mm", "number", 1.5, "mm", "domain window: length of solid bead kept behind the melt "
