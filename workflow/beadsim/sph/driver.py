@@ -386,7 +386,6 @@ class RunState:
     t_max: float = 0.0
     v_max: float = 0.0
     inflow_x: float = float("nan")
-    n_advected_out: int = 0
 
 
 class PerId:
@@ -504,8 +503,7 @@ class BeadRun:
         self.per_id.grow(last)
         self.per_id.max_t[first:last + 1] = self.T0
         self.per_id.wire_origin[first:last + 1] = True
-        m = self.num.mass
-        self.state.ledger.wire_in += len(pos) * (e0 + 0.5 * m * float(v @ v)) + m * GRAVITY * float(pos[:, 2].sum())
+        self.state.ledger.wire_in += self._entering_energy(pos, v, e0)
 
     def _pair_setup(self) -> tuple[list[str], list[str]]:
         """Pair sub-styles and pair_coeff lines; surface tension plugs in as one more overlay sub-style."""
@@ -618,6 +616,11 @@ class BeadRun:
             created = True
         return created
 
+    def _entering_energy(self, pos: np.ndarray, vel: np.ndarray, e0: float) -> float:
+        """Internal + kinetic + potential energy (J) of new particles at pos, all at velocity vel and energy e0."""
+        m = self.num.mass
+        return len(pos) * (e0 + 0.5 * m * float(vel @ vel)) + m * GRAVITY * float(pos[:, 2].sum())
+
     def _advect_window(self) -> bool:
         """Moving window: create the substrate layers that entered through the front face since the last call
         and delete everything that left through the rear face; both carry their energy (internal, kinetic,
@@ -654,7 +657,7 @@ class BeadRun:
             self.per_id.grow(st.next_id)
             self.per_id.max_t[ids] = self.T0
             self.per_id.face_area[ids] = scene.face_areas(g, pos)
-            st.ledger.advected_in += n * (e0 + 0.5 * m * float(vel @ vel)) + m * GRAVITY * float(pos[:, 2].sum())
+            st.ledger.advected_in += self._entering_energy(pos, vel, e0)
             created = True
         if not created:
             return False
@@ -667,9 +670,7 @@ class BeadRun:
                                    self._metrics(partial=True))
         energy = float(e[out].sum() + 0.5 * m * np.einsum("ij,ij->", v[out], v[out]) + m * GRAVITY * x[out, 2].sum())
         st.ledger.advected_out += allreduce(self.lmp, energy)
-        n_out = allreduce(self.lmp, int(out.sum()))
-        if n_out:
-            st.n_advected_out += n_out
+        if allreduce(self.lmp, int(out.sum())):
             self.deck("delete_atoms region behind compress no")
         return True
 
