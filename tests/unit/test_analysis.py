@@ -93,3 +93,24 @@ def test_speed_accuracy_against_table1_and_the_finest_run(experiments):
     assert t.loc["red", "error_reference"] == pytest.approx(0.5 * (4.0 / 3.3 - 1 + 0.5))
     assert np.isnan(t.loc["bad", "error_table1"])
     assert list(t["pareto_table1"]) == [True, True, True, False]
+
+
+def test_model_check_pairs_each_sph_run_with_its_reduced_twin():
+    import xarray as xr
+
+    from beadsim.analysis import model_check_table
+
+    ds = xr.Dataset(
+        {"bead_width_mm": ("case", [4.0, 5.0, 4.0, 3.0]), "bead_height_mm": ("case", [1.0, 0.8, 0.5, 0.6]),
+         "status": ("case", ["ok", "ok", "ok", "failed"]), "regime": ("case", ["ok", "flat_bead", "", ""])},
+        coords={"case": ["red_P1000", "red_P1300", "sph_P1300", "sph_P700"],
+                "model": ("case", ["reduced", "reduced", "sph", "sph"]),
+                "beam_power_W": ("case", [1000.0, 1300.0, 1300.0, 700.0]),
+                "resolution_mm": ("case", [0.3, 0.3, 0.4, 0.4])})
+    table = model_check_table(ds).set_index("run_id")
+    assert table.loc["sph_P1300", "reduced_run_id"] == "red_P1300"  # resolution does not split the pair
+    assert table.loc["sph_P1300", "reduced_regime"] == "flat_bead"
+    assert table.loc["sph_P1300", "bead_width_mm_rel"] == pytest.approx(5.0 / 4.0 - 1)
+    assert table.loc["sph_P1300", "bead_height_mm_rel"] == pytest.approx(0.8 / 0.5 - 1)
+    assert table.loc["sph_P700", "reduced_run_id"] == "" and np.isnan(table.loc["sph_P700", "bead_width_mm_reduced"])
+    assert "pool_length_mm_sph" not in table  # metrics absent from the dataset are skipped

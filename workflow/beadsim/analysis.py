@@ -269,3 +269,34 @@ def speed_accuracy_table(ds: xr.Dataset, exp: pd.DataFrame, reference: str | Non
     df["pareto_table1"] = pareto_front(df["cost_s"], df["error_table1"])
     df["pareto_reference"] = pareto_front(df["cost_s"], df["error_reference"])
     return df
+
+
+def model_check_table(ds: xr.Dataset, metrics=("bead_width_mm", "bead_height_mm", "pool_length_mm",
+                                              "pool_depth_mm")) -> pd.DataFrame:
+    """SPH checks of the reduced model: each SPH run beside the reduced run of the same scene.
+
+    The same scene: equal values of every parameter the reduced model reads, except ``model`` and
+    ``resolution_mm``. Per metric: both values and ``<metric>_rel`` = reduced / SPH - 1. SPH runs without a
+    reduced twin are listed with an empty ``reduced_run_id``.
+    """
+    from beadsim.parameters import all_parameters
+
+    keys = [n for n, p in all_parameters().items()
+            if "reduced" in p.models and n not in ("model", "resolution_mm") and n in ds]
+    model = ds["model"].values.astype(str)
+    scene = pd.DataFrame({k: ds[k].values for k in keys}).astype(str).agg("|".join, axis=1)
+    reduced = {s: i for i, s in reversed(list(enumerate(scene))) if model[i] == "reduced"}
+    rows = []
+    for i in np.where(model == "sph")[0]:
+        j = reduced.get(scene[i])
+        row = {"run_id": str(ds["case"].values[i]), "reduced_run_id": "" if j is None else str(ds["case"].values[j]),
+               "status": str(ds["status"].values[i]), "resolution_mm": float(ds["resolution_mm"].values[i]),
+               "reduced_regime": "" if j is None else str(ds["regime"].values[j])}
+        for m in metrics:
+            if m not in ds:
+                continue
+            s = float(ds[m].values[i])
+            r = np.nan if j is None else float(ds[m].values[j])
+            row |= {f"{m}_sph": s, f"{m}_reduced": r, f"{m}_rel": r / s - 1 if np.isfinite(s) and s else np.nan}
+        rows.append(row)
+    return pd.DataFrame(rows)

@@ -28,7 +28,8 @@ def main_block(ds: xr.Dataset, axes: list[str]) -> xr.Dataset:
     values are among the most frequent ones (so a stray case off the grid does not break a heat map).
 
     A study may be a union of blocks (measured modes beside a grid); a map shows the block that varies only
-    along its axes.
+    along its axes. Where several values are equally common (a full factorial grid), the middle one is kept: a
+    5-D grid is shown at the centre of its other axes.
     """
     keep = np.ones(ds.sizes["case"], dtype=bool)
     for name in swept_parameters(ds):
@@ -36,8 +37,15 @@ def main_block(ds: xr.Dataset, axes: list[str]) -> xr.Dataset:
         if name in axes:
             keep &= np.isin(ds[name].values, values[counts == counts.max()])
         else:
-            keep &= ds[name].values == values[np.argmax(counts)]
+            tied = values[counts == counts.max()]
+            keep &= ds[name].values == tied[(len(tied) - 1) // 2]
     return ds.isel(case=np.where(keep)[0])
+
+
+def fixed_values(shown: xr.Dataset, full: xr.Dataset, axes: list[str]) -> dict:
+    """The swept parameters not on the map axes and the one value the map shows them at."""
+    return {name: shown[name].values[0] for name in swept_parameters(full)
+            if name not in axes and shown.sizes["case"] and len(np.unique(shown[name].values)) == 1}
 
 
 def label(da: xr.DataArray) -> str:
@@ -55,11 +63,12 @@ def _frame(ds: xr.Dataset, cols: list[str]) -> pd.DataFrame:
 
 
 def process_maps(ds: xr.Dataset, map_x: str | None = None, map_y: str | None = None, map_facet: str | None = None,
-                 map_metrics: list[str] | None = None) -> plt.Figure:
+                 map_metrics: list[str] | None = None, experiments: pd.DataFrame | None = None) -> plt.Figure:
     """A grid of maps: one row per metric, one column per facet value.
 
     Two or more swept axes: heat maps on a full (x, y) grid, coloured scatter otherwise (Latin hypercube);
-    failed runs marked with a cross. One swept axis: lines. None: bars per case.
+    failed runs marked with a cross. One swept axis: lines. None: bars per case. ``experiments`` (Table 4 rows
+    indexed by mode) are overlaid as white stars on the maps whose facet value they share.
     """
     metrics = list(map_metrics or DEFAULT_METRICS)
     axes = swept_parameters(ds)
@@ -68,8 +77,11 @@ def process_maps(ds: xr.Dataset, map_x: str | None = None, map_y: str | None = N
     y = map_y or next((a for a in numeric if a != x), None)
     facet = map_facet or next((a for a in axes if a not in (x, y)), None)
     n_all = ds.sizes["case"]
+    fixed = {}
     if x is not None:
+        full = ds
         ds = main_block(ds, [a for a in (x, y, facet) if a])
+        fixed = fixed_values(ds, full, [a for a in (x, y, facet) if a])
     facet_vals = list(np.unique(ds[facet].values)) if facet else [None]
     fig, grid = plt.subplots(len(metrics), len(facet_vals), figsize=(4.2 * len(facet_vals), 3.3 * len(metrics)),
                              squeeze=False)
@@ -82,11 +94,67 @@ def process_maps(ds: xr.Dataset, map_x: str | None = None, map_y: str | None = N
             elif y is None:
                 _lines(ax, sub, x, metric)
             else:
-                _map(ax, sub, x, y, metric)
+                heat = _map(ax, sub, x, y, metric)
+                if experiments is not None:
+                    _overlay_experiments(ax, sub, x, y, facet, fv, experiments, heat)
             title = f"{facet} = {fv}" if facet else ""
             ax.set_title(f"{title}\n{metric}" if row == 0 and title else metric, fontsize=9)
+    at = ", ".join(f"{k} = {_tick(v.item() if hasattr(v, 'item') else v)}" for k, v in fixed.items())
     fig.suptitle(f"{ds.attrs.get('title', '')}: {ds.sizes['case']} of {n_all} runs shown, "
-                 f"{int((ds['status'].values == 'failed').sum())} failed", fontsize=10)
+                 f"{int((ds['status'].values == 'failed').sum())} failed" + (f"\nat {at}" if at else ""),
+                 fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def _overlay_experiments(ax, ds, x, y, facet, facet_value, experiments: pd.DataFrame, heat: bool):
+    """White stars at the measured modes' (x, y) on this panel (positions interpolated between heat-map cells)."""
+    if x not in experiments or y not in experiments:
+        return
+    rows = experiments
+    if facet and facet in experiments:
+        column = experiments[facet]
+        if pd.api.types.is_numeric_dtype(column):
+            rows = experiments[np.isclose(column.astype(float), float(facet_value))]
+        else:
+            rows = experiments[column.astype(str) == str(facet_value)]
+    xs, ys = np.unique(ds[x].values), np.unique(ds[y].values)
+    for mode, r in rows.iterrows():
+        px, py = float(r[x]), float(r[y])
+        if heat:  # cell centres at i + 0.5; y drawn descending
+            if not (xs.min() <= px <= xs.max() and ys.min() <= py <= ys.max()):
+                continue
+            px = np.interp(px, xs, np.arange(len(xs))) + 0.5
+            py = len(ys) - 1 - np.interp(py, ys, np.arange(len(ys))) + 0.5
+        ax.plot(px, py, "*", ms=13, mfc="white", mec="k")
+        ax.annotate(f"mode {mode}", (px, py), fontsize=7, xytext=(4, 4), textcoords="offset points")
+
+
+def main_effects_plot(ds: xr.Dataset, metrics: list[str] | None = None) -> plt.Figure:
+    """Main effects over a factorial or Latin-hypercube sweep: the mean of each metric (successful runs) at each
+    level of each swept numeric parameter, all other parameters averaged over. Shows every axis of a 5-D sweep
+    on one page; interactions are what the maps add."""
+    metrics = [m for m in (metrics or DEFAULT_METRICS) if m != "regime" and m in ds]
+    params = [p for p in swept_parameters(ds) if ds[p].dtype.kind == "f"]
+    ok = ds.isel(case=np.where(ds["status"].values == "ok")[0])
+    fig, grid = plt.subplots(len(metrics), max(len(params), 1), figsize=(3.2 * max(len(params), 1),
+                             2.6 * len(metrics)), squeeze=False, sharey="row")
+    for j, p in enumerate(params):
+        frame = pd.DataFrame({p: ok[p].values} | {m: ok[m].values for m in metrics})
+        levels = frame.groupby(p)
+        if levels.ngroups > 12:  # Latin hypercube: bin the axis
+            frame[p] = pd.cut(frame[p], 6).apply(lambda iv: iv.mid).astype(float)
+            levels = frame.groupby(p)
+        for i, m in enumerate(metrics):
+            ax = grid[i, j]
+            stats = levels[m].agg(["mean", "min", "max"])
+            ax.fill_between(stats.index, stats["min"], stats["max"], alpha=0.2, label="range")
+            ax.plot(stats.index, stats["mean"], "o-", label="mean")
+            ax.set_xlabel(label(ds[p]), fontsize=8)
+            if j == 0:
+                ax.set_ylabel(label(ds[m]), fontsize=8)
+    grid[0, 0].legend(fontsize=7)
+    fig.suptitle(f"main effects over {ok.sizes['case']} successful runs", fontsize=10)
     fig.tight_layout()
     return fig
 
@@ -95,14 +163,16 @@ def _regime_codes(values) -> np.ndarray:
     return np.array([REGIMES.index(v) if v in REGIMES else np.nan for v in values], dtype=float)
 
 
-def _map(ax, ds, x, y, metric):
+def _map(ax, ds, x, y, metric) -> bool:
+    """Heat map (full grid; returns True) or coloured scatter (returns False) of one metric over (x, y)."""
     df = _frame(ds, [x, y] + ([metric] if metric != "regime" else []))
     is_regime = metric == "regime"
     df["value"] = _regime_codes(df["regime"]) if is_regime else df[metric]
     df.loc[df["status"] != "ok", "value"] = np.nan
     cmap, norm = (REGIME_CMAP, REGIME_NORM) if is_regime else ("viridis", None)
     full = df.groupby([y, x]).size().unstack(x)
-    if full.notna().all().all() and len(df) == full.size:
+    heat = bool(full.notna().all().all() and len(df) == full.size)
+    if heat:
         table = df.pivot_table(index=y, columns=x, values="value", aggfunc="mean", dropna=False)
         table = table.sort_index(ascending=False)
         table.index = [_tick(v) for v in table.index]
@@ -127,6 +197,7 @@ def _map(ax, ds, x, y, metric):
         ax.legend(handles, present, fontsize=7, loc="best")
     ax.set_xlabel(label(ds[x]))
     ax.set_ylabel(label(ds[y]))
+    return heat
 
 
 def _tick(v) -> str:
@@ -289,6 +360,25 @@ def speed_accuracy_plot(table: pd.DataFrame) -> plt.Figure:
         ax.set_xlabel("wall time of the run, s (log)")
         ax.set_ylabel("mean |relative error| of width and height, %")
         ax.set_title(title + (" (red dotted: failed runs)" if len(failed) else ""), fontsize=9)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def uncertainty_plot(table: pd.DataFrame, metrics=("bead_width_mm", "bead_height_mm")) -> plt.Figure:
+    """Per mode: the 5-95 % band of the reduced model (bar), its median (dot), the nominal prediction (x) and the
+    measured bead with its assumed uncertainty (black square with error bar)."""
+    fig, axes = plt.subplots(1, len(metrics), figsize=(4.5 * len(metrics), 3.8), squeeze=False)
+    for ax, metric in zip(axes[0], metrics):
+        sub = table[table["metric"] == metric].sort_values("mode")
+        x = np.arange(len(sub))
+        ax.vlines(x - 0.1, sub["p05"], sub["p95"], lw=8, color="tab:blue", alpha=0.35, label="5-95 % band")
+        ax.plot(x - 0.1, sub["p50"], "o", color="tab:blue", label="median")
+        ax.plot(x - 0.1, sub["nominal"], "x", color="tab:orange", ms=9, label="nominal inputs")
+        if "measured" in sub:
+            ax.errorbar(x + 0.1, sub["measured"], yerr=sub["measured_unc"], fmt="ks", capsize=3, label="Table 1")
+        ax.set_xticks(x, [f"mode {m}" for m in sub["mode"]])
+        ax.set_ylabel(metric.replace("_mm", " [mm]").replace("_", " "))
         ax.legend(fontsize=7)
     fig.tight_layout()
     return fig

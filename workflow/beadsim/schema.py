@@ -144,6 +144,35 @@ def build_schema() -> dict:
                         "description": "Richardson extrapolation and GCI over a resolution ladder",
                         "properties": {"parameter": {"enum": numeric, "default": "resolution_mm"}},
                     },
+                    "uncertainty": {
+                        "type": "object",
+                        "additionalProperties": False,
+                        "description": "5-95 % bands of the reduced model's predictions of the measured modes "
+                                       "from a Latin hypercube over uncertain inputs (beadsim.uncertainty)",
+                        "properties": {
+                            "samples": {"type": "integer", "minimum": 4, "default": 32},
+                            "seed": {"type": "integer", "minimum": 0, "default": 0},
+                            "modes": {"type": "array", "items": {"type": "integer"},
+                                      "description": "measured modes (default: all in the experiments file)"},
+                            "ranges": {
+                                "type": "object",
+                                "additionalProperties": False,
+                                "description": "scene parameter -> [low, high] (default beam_efficiency: "
+                                               "[0.7, 0.95]); material ranges come from materials.yaml",
+                                "properties": {
+                                    n: {"type": "array", "minItems": 2, "maxItems": 2, "items": refs[n]}
+                                    for n in numeric
+                                },
+                            },
+                        },
+                    },
+                    "model_check": {
+                        "type": "object",
+                        "additionalProperties": False,
+                        "description": "each SPH run beside the reduced run of the same scene (SPH checks of "
+                                       "a reduced-model map)",
+                        "properties": {},
+                    },
                     "speed_accuracy": {
                         "type": "object",
                         "additionalProperties": False,

@@ -104,3 +104,51 @@ rule analyze_speed_accuracy:
         f"logs/{STUDY}/analyze_speed_accuracy.log",
     script:
         "../scripts/analyze_speed_accuracy.py"
+
+
+rule analyze_uncertainty:
+    input:
+        experiments=EXPERIMENTS_FILE,
+        materials=MATERIALS_FILE,
+    output:
+        samples=f"{OUT}/uncertainty/samples.csv",
+        table=report(
+            f"{OUT}/uncertainty/bands.csv",
+            caption="../report/uncertainty.rst",
+            category="Uncertainty",
+            labels={"table": "bands per mode"},
+        ),
+        figure=report(
+            f"{OUT}/uncertainty/bands.png",
+            caption="../report/uncertainty.rst",
+            category="Uncertainty",
+            labels={"figure": "bands against Table 1"},
+        ),
+    params:
+        options=lookup(dpath="analysis/uncertainty", within=config, default={}),
+        base=config.get("base", {}),
+    threads: 2
+    conda:
+        "../../envs/beadsim.yaml"
+    log:
+        f"logs/{STUDY}/analyze_uncertainty.log",
+    script:
+        "../scripts/analyze_uncertainty.py"
+
+
+rule check_models:
+    input:
+        f"{OUT}/dataset.nc",
+    output:
+        report(
+            f"{OUT}/model_check/table.csv",
+            caption="../report/model_check.rst",
+            category="Process maps",
+            labels={"table": "SPH checks of the reduced model"},
+        ),
+    conda:
+        "../../envs/beadsim.yaml"
+    log:
+        f"logs/{STUDY}/check_models.log",
+    script:
+        "../scripts/check_models.py"

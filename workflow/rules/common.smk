@@ -61,6 +61,10 @@ def get_final_output():
         extra += [f"{OUT}/stability/classes.csv", f"{OUT}/stability/stability_map.png"]
     if "speed_accuracy" in analyses:
         extra += [f"{OUT}/speed_accuracy/table.csv", f"{OUT}/speed_accuracy/pareto.png"]
+    if "uncertainty" in analyses:
+        extra += [f"{OUT}/uncertainty/bands.csv", f"{OUT}/uncertainty/bands.png"]
+    if "model_check" in analyses:
+        extra += [f"{OUT}/model_check/table.csv"]
     if "convergence" in analyses:
         extra += [f"{OUT}/convergence/richardson.csv", f"{OUT}/convergence/convergence.png"]
     sph_runs = [r for r in RUN_IDS if DESIGN.loc[r, "model"] == "sph"]
@@ -69,6 +73,7 @@ def get_final_output():
         f"{OUT}/dataset.nc",
         f"{OUT}/summary.csv",
         f"{OUT}/maps/process_maps.png",
+        f"{OUT}/maps/main_effects.png",
         f"{OUT}/comparison/errors.csv",
         f"{OUT}/comparison/parity.png",
         f"{OUT}/comparison/mass_balance.csv",

@@ -1,12 +1,19 @@
 rule plot_process_maps:
     input:
-        f"{OUT}/dataset.nc",
+        dataset=f"{OUT}/dataset.nc",
+        experiments=EXPERIMENTS_FILE,
     output:
-        report(
+        maps=report(
             f"{OUT}/maps/process_maps.png",
             caption="../report/process_map.rst",
             category="Process maps",
             labels={"figure": "process maps"},
+        ),
+        effects=report(
+            f"{OUT}/maps/main_effects.png",
+            caption="../report/main_effects.rst",
+            category="Process maps",
+            labels={"figure": "main effects"},
         ),
     params:
         options=config.get("report", {}),

@@ -1,0 +1,64 @@
+"""Process-map helpers on a constructed 3-D grid: the slice shown, the measured modes overlaid, main effects."""
+
+import itertools
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+import pytest
+import xarray as xr
+
+from beadsim.plots import fixed_values, main_block, main_effects_plot, process_maps
+
+POWERS, SPEEDS, FEEDS = [800.0, 1000.0, 1200.0], [3.0, 5.0, 7.0], [5.0, 10.0, 15.0]
+
+
+def width(p, vs, vw):
+    return 1e-3 * p + 0.1 * vw - 0.2 * vs
+
+
+@pytest.fixture
+def grid3():
+    cases = list(itertools.product(POWERS, SPEEDS, FEEDS))
+    p, vs, vw = (np.array(c) for c in zip(*cases))
+    coords = {"beam_power_W": ("case", p), "substrate_speed_mm_s": ("case", vs), "wire_feed_mm_s": ("case", vw)}
+    ds = xr.Dataset({"bead_width_mm": ("case", width(p, vs, vw)),
+                     "bead_height_mm": ("case", 0.05 * vw),
+                     "status": ("case", np.array(["ok"] * len(cases), dtype=object)),
+                     "regime": ("case", np.array(["ok"] * len(cases), dtype=object))},
+                    coords={"case": [f"c{i}" for i in range(len(cases))], **coords})
+    ds["status"].values[0] = "failed"  # P 800, Vs 3, Vw 5: left out of the means
+    return ds
+
+
+def test_grid_slice_is_the_middle_level_of_the_other_axes(grid3):
+    shown = main_block(grid3, ["beam_power_W", "substrate_speed_mm_s"])
+    assert shown.sizes["case"] == 9
+    assert set(shown["wire_feed_mm_s"].values) == {10.0}
+    assert fixed_values(shown, grid3, ["beam_power_W", "substrate_speed_mm_s"]) == {"wire_feed_mm_s": 10.0}
+
+
+def test_measured_mode_is_drawn_between_heat_map_cells(grid3):
+    experiments = pd.DataFrame({"beam_power_W": [900.0, 5000.0], "substrate_speed_mm_s": [5.0, 5.0]},
+                               index=pd.Index([1, 2], name="mode"))
+    fig = process_maps(grid3, "beam_power_W", "substrate_speed_mm_s", map_metrics=["bead_width_mm"],
+                       experiments=experiments)
+    ax = fig.axes[0]  # the third axis (wire feed) is the facet: one panel per feed
+    stars = [line for line in ax.lines if line.get_marker() == "*"]
+    assert len(stars) == 1  # mode 2 lies outside the map
+    assert sum(line.get_marker() == "*" for a in fig.axes for line in a.lines) == 3  # no feed given: every panel
+    # 900 W is halfway between the first two columns (centres 0.5, 1.5); 5 mm/s is the middle row (centre 1.5)
+    assert stars[0].get_xdata()[0] == pytest.approx(1.0)
+    assert stars[0].get_ydata()[0] == pytest.approx(1.5)
+    plt.close(fig)
+
+
+def test_main_effects_are_level_means_of_successful_runs(grid3):
+    fig = main_effects_plot(grid3, ["bead_width_mm", "regime"])
+    axes = np.array(fig.axes).reshape(1, 3)
+    line = [ln for ln in axes[0, 2].lines if ln.get_marker() == "o"][0]  # width against wire feed
+    assert list(line.get_xdata()) == FEEDS
+    ok = [(p, vs, vw) for p, vs, vw in itertools.product(POWERS, SPEEDS, FEEDS) if (p, vs, vw) != (800, 3, 5)]
+    expected = [np.mean([width(*c) for c in ok if c[2] == f]) for f in FEEDS]
+    np.testing.assert_allclose(line.get_ydata(), expected, rtol=1e-12)
+    plt.close(fig)
