@@ -105,7 +105,7 @@ def choose_numerics(params: dict, mat: Material, geom: SceneGeometry) -> Numeric
         c0 = max(c0, cohesion.min_sound_speed(mat))
     nu = mat.nu if params["viscosity_model"] == "morris" else params["artificial_viscosity"] * c0 * h / 8
     limits = {"acoustic": 0.1 * h / c0, "viscous": 0.125 * h * h / max(nu, 1e-30),
-              "thermal": 0.1 * dx * dx / mat.diffusivity, "gravity": 0.25 * math.sqrt(h / GRAVITY)}
+              "thermal": 0.1 * dx * dx / (mat.diffusivity * params["melt_conductivity_factor"]), "gravity": 0.25 * math.sqrt(h / GRAVITY)}
     tait_rho0 = mat.rho
     if cohesion is not None:
         limits["capillary"] = cohesion.dt_limit(mat, dx, c0, params["artificial_viscosity"])
@@ -517,6 +517,9 @@ class BeadRun:
                       f"{h:.9g}"]
         styles.append("sph/heatconduction")
         coeffs.append(f"pair_coeff * * sph/heatconduction {self.mat.diffusivity:.9g} {h:.9g}")
+        if self.p["melt_conductivity_factor"] != 1:  # Marangoni stand-in: liquid-liquid pairs only (symmetric)
+            d_melt = self.mat.diffusivity * self.p["melt_conductivity_factor"]
+            coeffs.append(f"pair_coeff {TYPE_LIQUID} {TYPE_LIQUID} sph/heatconduction {d_melt:.9g} {h:.9g}")
         model = self.num.cohesion
         if model is not None:  # surface tension: one more overlay sub-style, liquid-liquid and liquid-solid
             styles.append(model.pair_style_tokens())

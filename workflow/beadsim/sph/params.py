@@ -32,6 +32,10 @@ SPH_PARAMETERS: list[Param] = [
     Param("mushy_range_K", "number", 50.0, "K", "temperature range over which the latent heat is released "
           "(latent_heat true)", exclusive_minimum=0, maximum=1000, short="dTm", models=_SPH,
           long_name="mushy range"),
+    Param("melt_conductivity_factor", "number", 1.0, "1", "multiplies the thermal conductivity between liquid "
+          "particles, standing for the heat the Marangoni flow carries through a real pool (an enhanced-"
+          "conductivity model, beyond the paper; weld-pool models use 2-10); 1 = the paper's conduction",
+          minimum=1, maximum=50, short="fk", models=_SPH, long_name="melt conductivity factor"),
     Param("temperature_cap", "boolean", True, "", "cap temperatures at the boiling point and count the excess "
           "energy as evaporation", short="cap", models=_SPH),
     Param("thermal_boundary", "string", "farfield", "", "side/bottom faces of the modelled block that cut the "
