@@ -62,3 +62,14 @@ def test_main_effects_are_level_means_of_successful_runs(grid3):
     expected = [np.mean([width(*c) for c in ok if c[2] == f]) for f in FEEDS]
     np.testing.assert_allclose(line.get_ydata(), expected, rtol=1e-12)
     plt.close(fig)
+
+
+def test_a_measured_mode_on_a_grid_level_does_not_hide_the_other_levels(grid3):
+    extra = grid3.isel(case=[13]).assign_coords(case=["mode1"])  # P 1000, Vs 5, Vw 10: on the grid
+    both = xr.concat([grid3, extra], dim="case")
+    shown = main_block(both, ["beam_power_W", "substrate_speed_mm_s"])
+    assert sorted(set(shown["beam_power_W"].values)) == POWERS
+    assert shown.sizes["case"] == 10 and set(shown["wire_feed_mm_s"].values) == {10.0}
+    fig = process_maps(both, "beam_power_W", "substrate_speed_mm_s", "wire_feed_mm_s", ["bead_width_mm"])
+    assert len(fig.axes[0].collections) == 1  # still a heat map: the repeated point is averaged into its cell
+    plt.close(fig)

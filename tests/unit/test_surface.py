@@ -158,3 +158,17 @@ def test_penetration_depth_of_melted_ellipsoid():
     # the arc's drop over |x| <= 1 mm (c (1 - sqrt(1 - 1/9)) = 0.034 mm)
     assert depth == pytest.approx(c * 1e3, abs=0.5 * DX * 1e3 + 0.034)
     assert penetration_depth(sub, np.zeros(len(sub), bool), DX, (-1e-3, 1e-3)) == 0.0
+
+
+def test_width_edges_are_interpolated_on_averaged_profiles():
+    """A profile averaged over sections has fractional heights: the edges sit where it crosses dx/2."""
+    from beadsim.sph.surface import profile_metrics
+
+    dx = 4e-4
+    h = np.array([0.0, 0.5, 1.0, 2.0, 1.0, 0.25, 0.0]) * dx
+    y = (np.arange(len(h)) - 3) * dx
+    # left: between 1.0 and 0.5 -> a whole bin beyond the run; right: (1 - 0.5) / (1 - 0.25) of a bin
+    expected = (3 - 1 + 1.0 + 0.5 / 0.75) * dx * 1e3
+    assert profile_metrics(y, h, dx)["bead_width_mm"] == pytest.approx(expected, rel=1e-12)
+    lattice = np.array([np.nan, 0.0, 1.0, 1.0, 1.0, 0.0]) * dx  # whole layers: n dx as before
+    assert profile_metrics(y[:6], lattice, dx)["bead_width_mm"] == pytest.approx(3 * dx * 1e3, rel=1e-12)

@@ -25,20 +25,21 @@ REGIME_NORM = BoundaryNorm(np.arange(-0.5, len(REGIMES)), len(REGIMES))
 
 def main_block(ds: xr.Dataset, axes: list[str]) -> xr.Dataset:
     """The cases that share the most common value of every swept parameter not in ``axes``, and whose axis
-    values are among the most frequent ones (so a stray case off the grid does not break a heat map).
+    values are among the most frequent ones (at least half as frequent as the most frequent: a stray case off
+    the grid does not break a heat map, a case on a grid level does not hide the others).
 
     A study may be a union of blocks (measured modes beside a grid); a map shows the block that varies only
     along its axes. Where several values are equally common (a full factorial grid), the middle one is kept: a
-    5-D grid is shown at the centre of its other axes.
+    5-D grid is shown at the centre of its other axes (the middle of the common levels).
     """
     keep = np.ones(ds.sizes["case"], dtype=bool)
     for name in swept_parameters(ds):
         values, counts = np.unique(ds[name].values[keep], return_counts=True)
+        common = values[counts >= 0.5 * counts.max()]  # grid levels; a measured mode on a level adds one
         if name in axes:
-            keep &= np.isin(ds[name].values, values[counts == counts.max()])
+            keep &= np.isin(ds[name].values, common)
         else:
-            tied = values[counts == counts.max()]
-            keep &= ds[name].values == tied[(len(tied) - 1) // 2]
+            keep &= ds[name].values == common[(len(common) - 1) // 2]
     return ds.isel(case=np.where(keep)[0])
 
 
@@ -108,7 +109,8 @@ def process_maps(ds: xr.Dataset, map_x: str | None = None, map_y: str | None = N
 
 
 def _overlay_experiments(ax, ds, x, y, facet, facet_value, experiments: pd.DataFrame, heat: bool):
-    """White stars at the measured modes' (x, y) on this panel (positions interpolated between heat-map cells)."""
+    """White stars at the measured modes' (x, y) on this panel (positions interpolated between heat-map cells),
+    for the modes that share the values the panel holds fixed (material, wire feed, ...)."""
     if x not in experiments or y not in experiments:
         return
     rows = experiments
@@ -118,6 +120,14 @@ def _overlay_experiments(ax, ds, x, y, facet, facet_value, experiments: pd.DataF
             rows = experiments[np.isclose(column.astype(float), float(facet_value))]
         else:
             rows = experiments[column.astype(str) == str(facet_value)]
+    for name in experiments.columns:  # parameters the panel holds at one value: the mode must share it
+        if name in (x, y, facet) or name not in ds.coords or len(np.unique(ds[name].values)) != 1:
+            continue
+        held = ds[name].values[0]
+        if pd.api.types.is_numeric_dtype(experiments[name]):
+            rows = rows[np.isclose(rows[name].astype(float), float(held))]
+        else:
+            rows = rows[rows[name].astype(str) == str(held)]
     xs, ys = np.unique(ds[x].values), np.unique(ds[y].values)
     for mode, r in rows.iterrows():
         px, py = float(r[x]), float(r[y])
@@ -171,7 +181,7 @@ def _map(ax, ds, x, y, metric) -> bool:
     df.loc[df["status"] != "ok", "value"] = np.nan
     cmap, norm = (REGIME_CMAP, REGIME_NORM) if is_regime else ("viridis", None)
     full = df.groupby([y, x]).size().unstack(x)
-    heat = bool(full.notna().all().all() and len(df) == full.size)
+    heat = bool(full.notna().all().all())  # every cell filled; a case repeated on a grid point is averaged
     if heat:
         table = df.pivot_table(index=y, columns=x, values="value", aggfunc="mean", dropna=False)
         table = table.sort_index(ascending=False)

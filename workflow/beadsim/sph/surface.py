@@ -165,7 +165,10 @@ def bead_cross_section(pos, dx, x_window, z_surface=0.0, mask=None):
 
     Method: the :func:`height_map` profile h(y). The bead is the contiguous run of y bins, containing the
     highest bin, where ``h > dx/2`` (at least half a particle above the original surface; on a lattice h is a
-    whole number of ``dx`` so this means one particle layer). Width = number of bins in the run times ``dx``;
+    whole number of ``dx`` so this means one particle layer). Width = the distance between the two points where
+    the profile crosses ``dx/2``, interpolated linearly between the run's outermost bins and their outer
+    neighbours (half a bin beyond where the neighbour is empty): the number of bins times ``dx`` when the edge
+    bins hold one particle layer, continuous on a profile averaged over sections or times;
     height = the largest h; area = the sum of ``max(h, 0) dx`` over all bins (material above the surface;
     depressions do not subtract). The contact angle comes from a least-squares circle through the (y, h)
     points of the run and the run's two outer edges on the surface (h = 0): ``theta = arccos(-zc / R)``.
@@ -190,16 +193,32 @@ def bead_cross_section(pos, dx, x_window, z_surface=0.0, mask=None):
     return profile_metrics(*height_map(pos, dx, x_window, z_surface, mask), dx)
 
 
+def _edge_fraction(h: np.ndarray, inner: int, outer: int, threshold: float) -> float:
+    """Where the profile crosses ``threshold`` between the bin centres ``inner`` (above) and ``outer`` (below),
+    as a fraction of a bin beyond ``inner``: linear between the two heights, the outer one clipped at 0 (a
+    depression beside the bead does not pull its edge in); half a bin where the outer bin is empty or missing."""
+    if outer < 0 or outer >= len(h) or not np.isfinite(h[outer]):
+        return 0.5
+    h_in, h_out = float(h[inner]), max(float(h[outer]), 0.0)
+    return float(np.clip((h_in - threshold) / (h_in - h_out), 0.0, 1.0)) if h_in > h_out else 0.5
+
+
 def profile_metrics(y: np.ndarray, h: np.ndarray, dx: float) -> dict:
     """Width, height, area and contact angle of a height profile h(y) (m) on bins of width dx, as in
     :func:`bead_cross_section` (which applies it to one :func:`height_map`; the moving-window driver applies it
     to the mean of several maps taken at different times)."""
-    run = _bead_run(h, 0.5 * dx)
+    threshold = 0.5 * dx
+    run = _bead_run(h, threshold)
     n_bins = run.stop - run.start
     height = float(np.nanmax(h)) if n_bins else 0.0
     area = float(np.nansum(np.clip(h, 0.0, None)) * dx)
+    width = 0.0
+    if n_bins:
+        ends = [_edge_fraction(h, run.start, run.start - 1, threshold),
+                _edge_fraction(h, run.stop - 1, run.stop, threshold)]
+        width = (n_bins - 1 + sum(ends)) * dx
     return {
-        "bead_width_mm": n_bins * dx * 1e3,
+        "bead_width_mm": width * 1e3,
         "bead_height_mm": max(height, 0.0) * 1e3,
         "bead_area_mm2": area * 1e6,
         "contact_angle_deg": arc_contact_angle(*_with_edges(y[run], h[run], dx)),
