@@ -40,10 +40,15 @@ log = logging.getLogger("beadsim.bench")
 LEVERS = {"domain": "window", "stop_at_steady_state": True}
 
 
+#: The production physics of the table4_sph study (the same in every bench run, so that comparisons are fair).
+PHYSICS = {"melt_conductivity_factor": 5.0}
+
+
 def mode_params(mode: int, **overrides) -> dict:
-    """Parameters of Table 4 mode ``mode`` with the SPH model and ``overrides``."""
+    """Parameters of Table 4 mode ``mode`` with the SPH model, the production physics and ``overrides``."""
     p = defaults()
     p["model"] = "sph"
+    p.update(PHYSICS)
     row = load_experiments().loc[mode]
     for key, value in row.items():
         if key in p:
