@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pandas as pd
 import pytest
 import xarray as xr
 import yaml
@@ -46,7 +47,15 @@ def test_dataset_and_outputs(tiny_run):
     # The comparison found the two measured modes.
     errors = (out / "comparison" / "errors.csv").read_text().splitlines()
     assert len(errors) == 3 and errors[1].startswith("mode1,1,reduced")
-    for png in ("maps/process_maps.png", "comparison/parity.png"):
+    # Uncertainty bands of mode 1 from 4 Latin-hypercube samples: ordered quantiles, the nominal run recorded.
+    bands = pd.read_csv(out / "uncertainty" / "bands.csv").set_index("metric")
+    width = bands.loc["bead_width_mm"]
+    assert width["mode"] == 1 and width["samples_ok"] == 4
+    assert width["p05"] <= width["p50"] <= width["p95"] and width["p05"] < width["p95"]
+    assert width["nominal"] == pytest.approx(float(ds["bead_width_mm"].sel(case="mode1")), rel=1e-9)
+    assert len(pd.read_csv(out / "uncertainty" / "samples.csv")) == 4
+    for png in ("maps/process_maps.png", "maps/main_effects.png", "comparison/parity.png",
+                "uncertainty/bands.png"):
         assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
         assert (out / png).stat().st_size > 20_000
 
