@@ -173,14 +173,21 @@ def test_moving_window_conserves_energy_and_feeds_substrate(tmp_path):
 
 
 def test_enhanced_melt_conductivity_spreads_the_heat_and_keeps_the_ledger(small_bead, tmp_path):
-    """melt_conductivity_factor (Marangoni stand-in) raises conduction between liquid particles only: the
-    surface under the beam reaches the boiling cap less often, so less beam energy is counted as evaporated
-    than in the paper's conduction, and the energy ledger still closes."""
+    """melt_conductivity_factor (Marangoni stand-in) raises conduction between liquid particles (and, with the
+    harmonic interface, between liquid and solid at the series conductance): the surface under the beam reaches
+    the boiling cap less often, so less beam energy is counted as evaporated than in the paper's conduction, and
+    the energy ledger still closes."""
     _, base, _ = small_bead
-    params = small_case(melt_conductivity_factor=5.0)
+    params = small_case(melt_conductivity_factor=5.0, melt_interface_conductivity="harmonic")
     m = run_case(params, tmp_path)
     deck = (tmp_path / "deck.in").read_text()
-    assert "pair_coeff 3 3 sph/heatconduction" in deck  # liquid-liquid pairs (type 3) only
+    d = float(next(line for line in deck.splitlines() if line.startswith("pair_coeff * * sph/heatconduction"))
+              .split()[4])
+    lines = {tuple(line.split()[1:3]): float(line.split()[4]) for line in deck.splitlines()
+             if line.startswith("pair_coeff") and "sph/heatconduction" in line}
+    assert lines[("3", "3")] == pytest.approx(5 * d)  # liquid-liquid (type 3)
+    for pair in (("1", "3"), ("2", "3"), ("3", "4")):  # liquid-solid: harmonic mean 2 f / (1 + f)
+        assert lines[pair] == pytest.approx(d * 10 / 6)
     assert abs(m["energy_balance_error"]) < ENERGY_BALANCE_TOL
     assert base["evaporated_energy_J"] > 0
     assert m["evaporated_energy_J"] < 0.8 * base["evaporated_energy_J"]

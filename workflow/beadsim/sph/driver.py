@@ -517,9 +517,15 @@ class BeadRun:
                       f"{h:.9g}"]
         styles.append("sph/heatconduction")
         coeffs.append(f"pair_coeff * * sph/heatconduction {self.mat.diffusivity:.9g} {h:.9g}")
-        if self.p["melt_conductivity_factor"] != 1:  # Marangoni stand-in: liquid-liquid pairs only (symmetric)
-            d_melt = self.mat.diffusivity * self.p["melt_conductivity_factor"]
-            coeffs.append(f"pair_coeff {TYPE_LIQUID} {TYPE_LIQUID} sph/heatconduction {d_melt:.9g} {h:.9g}")
+        f = self.p["melt_conductivity_factor"]
+        if f != 1:  # Marangoni stand-in: liquid-liquid pairs (symmetric), optionally liquid-solid at the harmonic mean
+            coeffs.append(f"pair_coeff {TYPE_LIQUID} {TYPE_LIQUID} sph/heatconduction "
+                          f"{self.mat.diffusivity * f:.9g} {h:.9g}")
+            if self.p["melt_interface_conductivity"] == "harmonic":
+                d_int = self.mat.diffusivity * 2 * f / (1 + f)
+                for other in (TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED):
+                    i, j = sorted((TYPE_LIQUID, other))
+                    coeffs.append(f"pair_coeff {i} {j} sph/heatconduction {d_int:.9g} {h:.9g}")
         model = self.num.cohesion
         if model is not None:  # surface tension: one more overlay sub-style, liquid-liquid and liquid-solid
             styles.append(model.pair_style_tokens())
@@ -841,6 +847,8 @@ class BeadRun:
         m["pool_y_abs_max"] = allreduce(lmp, float(yl.max()) if liquid.any() else 0.0, "max")
         zw = self._x()[self._types() == TYPE_WIRE, 2]
         m["wire_z_min"] = allreduce(lmp, float(zw.min()) if len(zw) else np.inf, "min")
+        zl = self._x()[liquid, 2]
+        m["melt_z_min"] = allreduce(lmp, float(zl.min()) if liquid.any() else np.inf, "min")
         return m
 
     def _watchdog(self, m: dict, expected_atoms: int) -> None:
@@ -855,9 +863,10 @@ class BeadRun:
                 m["pool_y_abs_max"] > self.geom.y_hi:
             reason = (f"melt reached the side face of the moving window (|y| {m['pool_y_abs_max'] * 1e3:.2f} mm of "
                       f"{self.geom.y_hi * 1e3:.2f} mm) {where}: raise window_thermal_lengths")
-        elif m["wire_z_min"] < -2 * self.geom.dx:
-            reason = (f"solid wire reached {-m['wire_z_min'] * 1e3:.2f} mm below the surface {where}: the beam "
-                      "does not melt the wire as fast as it is fed (stubbing)")
+        elif m["wire_z_min"] < min(-2 * self.geom.dx, m["melt_z_min"] - self.geom.dx):
+            # a wire dipping into the pool melts there; one pushed below the pool ploughs through solid metal
+            reason = (f"solid wire reached {-m['wire_z_min'] * 1e3:.2f} mm below the surface, below the melt "
+                      f"{where}: neither the beam nor the pool melts the wire as fast as it is fed (stubbing)")
         elif m["rho_min"] < 1 - tol or m["rho_max"] > 1 + tol:
             reason = (f"liquid density {m['rho_min']:.3f}-{m['rho_max']:.3f} rho0 outside 1 +- {tol:g} {where}")
         elif m["v_max"] > self.speed_limit:
@@ -1010,7 +1019,8 @@ class BeadRun:
                          for k in keys},
                         coords={"time": ("time", np.array([m["t"] for m in self.series]), {"units": "s"})})
         units = {"T_max": "K", "rho_min": "1", "rho_max": "1", "v_max": "m s-1", "steps_per_s": "s-1",
-                 "pool_x_min": "m", "pool_x_max": "m", "energy_error": "1", "bead_width_mm": "mm",
+                 "pool_x_min": "m", "pool_x_max": "m", "pool_y_abs_max": "m", "wire_z_min": "m",
+                 "melt_z_min": "m", "energy_error": "1", "bead_width_mm": "mm",
                  "bead_height_mm": "mm", "bead_area_mm2": "mm2", "contact_angle_deg": "degree",
                  "penetration_depth_mm": "mm"}
         for k in ds.data_vars:

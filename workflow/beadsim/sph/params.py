@@ -36,6 +36,10 @@ SPH_PARAMETERS: list[Param] = [
           "particles, standing for the heat the Marangoni flow carries through a real pool (an enhanced-"
           "conductivity model, beyond the paper; weld-pool models use 2-10); 1 = the paper's conduction",
           minimum=1, maximum=50, short="fk", models=_SPH, long_name="melt conductivity factor"),
+    Param("melt_interface_conductivity", "string", "solid", "", "conductivity of liquid-solid particle pairs when "
+          "melt_conductivity_factor > 1: solid (the solid's, as in the paper) or harmonic (harmonic mean of the "
+          "enhanced melt and the solid: 2f/(1+f) times the solid's, the series conductance of the two sides)",
+          enum=("solid", "harmonic"), short="fki", models=_SPH),
     Param("temperature_cap", "boolean", True, "", "cap temperatures at the boiling point and count the excess "
           "energy as evaporation", short="cap", models=_SPH),
     Param("thermal_boundary", "string", "farfield", "", "side/bottom faces of the modelled block that cut the "
