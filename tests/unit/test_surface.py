@@ -172,3 +172,19 @@ def test_width_edges_are_interpolated_on_averaged_profiles():
     assert profile_metrics(y, h, dx)["bead_width_mm"] == pytest.approx(expected, rel=1e-12)
     lattice = np.array([np.nan, 0.0, 1.0, 1.0, 1.0, 0.0]) * dx  # whole layers: n dx as before
     assert profile_metrics(y[:6], lattice, dx)["bead_width_mm"] == pytest.approx(3 * dx * 1e3, rel=1e-12)
+
+
+def test_fusion_width_is_the_molten_top_seen_from_above():
+    """A flat bead one layer thick (too thin for a robust height-threshold width) on a substrate whose top
+    layer melted 1 mm wider than the bead: the fused width is the molten top, bead included."""
+    from beadsim.sph.surface import fusion_width
+
+    substrate = lattice((0.0, -3e-3, -1e-3), (2e-3, 3e-3, 0.0))
+    bead = lattice((0.0, -1e-3, 0.0), (2e-3, 1e-3, DX))  # 2 mm wide, one layer
+    pos = np.vstack([substrate, bead])
+    melted = (np.abs(pos[:, 1]) < 1.5e-3) & (pos[:, 2] > -3 * DX)  # 3 mm wide molten top, 3 layers deep
+    assert fusion_width(pos, melted, DX, WINDOW) == pytest.approx(3.0, abs=1e-9)
+    assert fusion_width(pos, np.zeros(len(pos), bool), DX, WINDOW) == 0.0
+    # a stray unmolten particle on top of one column does not cut the fused run (medians over x columns)
+    stray = np.array([[0.5 * DX, 0.05e-3, 1.5 * DX]])
+    assert fusion_width(np.vstack([pos, stray]), np.append(melted, False), DX, WINDOW) == pytest.approx(3.0)

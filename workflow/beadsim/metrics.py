@@ -13,6 +13,7 @@ METRICS: dict[str, tuple[str, str]] = {
     "aspect_ratio": ("1", "bead height / width"),
     "contact_angle_deg": ("degree", "bead contact angle"),
     "penetration_depth_mm": ("mm", "remelt depth into substrate"),
+    "fusion_width_mm": ("mm", "width of the fused (ever-molten) top surface"),
     "pool_length_mm": ("mm", "melt pool length"),
     "pool_width_mm": ("mm", "melt pool width"),
     "pool_depth_mm": ("mm", "melt pool depth"),

@@ -954,7 +954,7 @@ class BeadRun:
     def _bead_check(self) -> dict:
         """Bead cross-section now (moving window), for the steady-state test and the final average."""
         keys = ("bead_width_mm", "bead_height_mm", "bead_area_mm2", "contact_angle_deg", "mass_balance_ratio",
-                "penetration_depth_mm")
+                "penetration_depth_mm", "fusion_width_mm")
         out = self._bead_metrics(self._supply_mm2())
         if "profile" in out:
             self.profiles = (self.profiles + [out["profile"]])[-3:]
@@ -1175,6 +1175,7 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
     out.update(surface.profile_metrics(y_bins, top, geom.dx))
     out["profile"] = (y_bins, top)
     out["penetration_depth_mm"] = surface.penetration_depth(x, melted, geom.dx, window, z_surface=0.0)
+    out["fusion_width_mm"] = surface.fusion_width(x[deposit], melted[deposit], geom.dx, window, z_surface=0.0)
     if out.get("bead_width_mm"):
         out["aspect_ratio"] = out["bead_height_mm"] / out["bead_width_mm"]
     log.info("bead window %.2f-%.2f mm: net added area %.3g mm2 (wire %.3g mm2, ratio %.3f)",

@@ -300,3 +300,36 @@ def penetration_depth(pos, melted_mask, dx, x_window, z_surface=0.0):
     _, bottom = _column_median(pos, dx, x_window, melted_mask, pos[:, 2] - 0.5 * dx, np.minimum)
     depth = z_surface - bottom[np.isfinite(bottom)]
     return float(max(depth.max(initial=0.0), 0.0)) * 1e3
+
+
+def fusion_width(pos, melted_mask, dx, x_window, z_surface=0.0):
+    """Width of the fused track seen from above (mm): the lateral extent of the top surface that was ever liquid.
+
+    Method: two :func:`height_map` profiles over the window, of all material and of the ever-melted material
+    only; a y bin is fused where the melted top lies within ``dx/2`` of the top (the particle on top of the
+    median column has been liquid). The width is the number of bins in the contiguous fused run that contains
+    the highest bin, times ``dx``. Unlike the height threshold of :func:`bead_cross_section` it does not need
+    the bead to stand a particle layer above the surface, so it stays defined for a flat bead a layer or two
+    thick; it is also wider than the bead where the pool melted the substrate beside it.
+
+    Parameters
+    ----------
+    pos, melted_mask, dx, x_window, z_surface
+        As for :func:`penetration_depth`.
+
+    Returns
+    -------
+    float
+        Width in mm (0 if no bin is fused).
+    """
+    pos = np.asarray(pos, dtype=float).reshape(-1, 3)
+    _, top = height_map(pos, dx, x_window, z_surface)
+    _, top_melt = height_map(pos, dx, x_window, z_surface, mask=np.asarray(melted_mask, dtype=bool))
+    if len(top) == 0:
+        return 0.0
+    fused = np.isfinite(top) & np.isfinite(top_melt) & (np.nan_to_num(top_melt, nan=-np.inf) >= top - 0.5 * dx)
+    if not fused.any():
+        return 0.0
+    heights = np.where(fused, np.nan_to_num(top, nan=-np.inf), -np.inf)
+    run = _bead_run(np.where(fused, heights, np.nan), -np.inf)
+    return (run.stop - run.start) * dx * 1e3
