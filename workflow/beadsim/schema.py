@@ -36,6 +36,9 @@ def build_schema() -> dict:
     refs = {name: {"$ref": f"#/$defs/{name}"} for name in params}
     numeric = [n for n, p in params.items() if p.type == "number"]
 
+    def low_high() -> dict:  # [low, high] of each numeric parameter (a new dict each time: no YAML anchors)
+        return {n: {"type": "array", "minItems": 2, "maxItems": 2, "items": refs[n]} for n in numeric}
+
     def lists(min_items=1):
         return {
             "type": "object",
@@ -96,10 +99,7 @@ def build_schema() -> dict:
                                 "type": "object",
                                 "minProperties": 1,
                                 "additionalProperties": False,
-                                "properties": {
-                                    n: {"type": "array", "minItems": 2, "maxItems": 2, "items": refs[n]}
-                                    for n in numeric
-                                },
+                                "properties": low_high(),
                             },
                         },
                     },
@@ -159,10 +159,7 @@ def build_schema() -> dict:
                                 "additionalProperties": False,
                                 "description": "scene parameter -> [low, high] (default beam_efficiency: "
                                                "[0.7, 0.95]); material ranges come from materials.yaml",
-                                "properties": {
-                                    n: {"type": "array", "minItems": 2, "maxItems": 2, "items": refs[n]}
-                                    for n in numeric
-                                },
+                                "properties": low_high(),
                             },
                         },
                     },
