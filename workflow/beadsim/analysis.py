@@ -225,6 +225,11 @@ def stability_table(ds: xr.Dataset, density_band: float = 0.05, energy_band: flo
     return df
 
 
+def _mean_rel_error(width, height, width_ref, height_ref):
+    """Mean of the absolute relative errors of bead width and height against reference values."""
+    return 0.5 * (abs(width / width_ref - 1) + abs(height / height_ref - 1))
+
+
 def speed_accuracy_table(ds: xr.Dataset, exp: pd.DataFrame, reference: str | None = None) -> pd.DataFrame:
     """Cost and error of every run, for a speed-vs-accuracy (Pareto) chart.
 
@@ -251,8 +256,7 @@ def speed_accuracy_table(ds: xr.Dataset, exp: pd.DataFrame, reference: str | Non
     ok = df["status"] == "ok"
     meas_w = df["mode"].map(lambda m: exp.loc[int(m), "bead_width_mm"] if np.isfinite(m) else np.nan)
     meas_h = df["mode"].map(lambda m: exp.loc[int(m), "bead_height_mm"] if np.isfinite(m) else np.nan)
-    df["error_table1"] = np.where(ok, 0.5 * (abs(df["width_mm"] / meas_w - 1) + abs(df["height_mm"] / meas_h - 1)),
-                                  np.nan)
+    df["error_table1"] = np.where(ok, _mean_rel_error(df["width_mm"], df["height_mm"], meas_w, meas_h), np.nan)
     df["reference"] = ""
     df["error_reference"] = np.nan
     for mode, grp in df[df["mode"].notna()].groupby("mode"):
@@ -263,7 +267,7 @@ def speed_accuracy_table(ds: xr.Dataset, exp: pd.DataFrame, reference: str | Non
             if cand.empty:
                 continue
             ref = cand.sort_values(["resolution_mm", "cost_s"], ascending=[True, False]).iloc[0]
-        err = 0.5 * (abs(grp["width_mm"] / ref["width_mm"] - 1) + abs(grp["height_mm"] / ref["height_mm"] - 1))
+        err = _mean_rel_error(grp["width_mm"], grp["height_mm"], ref["width_mm"], ref["height_mm"])
         df.loc[grp.index, "reference"] = ref["run_id"]
         df.loc[grp.index, "error_reference"] = np.where(grp["status"] == "ok", err, np.nan)
     df["pareto_table1"] = pareto_front(df["cost_s"], df["error_table1"])

@@ -113,21 +113,16 @@ def _overlay_experiments(ax, ds, x, y, facet, facet_value, experiments: pd.DataF
     for the modes that share the values the panel holds fixed (material, wire feed, ...)."""
     if x not in experiments or y not in experiments:
         return
+    held = {facet: facet_value} if facet and facet in experiments else {}
+    for name in experiments.columns:  # parameters the panel holds at one value: the mode must share them
+        if name not in (x, y, facet) and name in ds.coords and len(np.unique(ds[name].values)) == 1:
+            held[name] = ds[name].values[0]
     rows = experiments
-    if facet and facet in experiments:
-        column = experiments[facet]
-        if pd.api.types.is_numeric_dtype(column):
-            rows = experiments[np.isclose(column.astype(float), float(facet_value))]
-        else:
-            rows = experiments[column.astype(str) == str(facet_value)]
-    for name in experiments.columns:  # parameters the panel holds at one value: the mode must share it
-        if name in (x, y, facet) or name not in ds.coords or len(np.unique(ds[name].values)) != 1:
-            continue
-        held = ds[name].values[0]
-        if pd.api.types.is_numeric_dtype(experiments[name]):
-            rows = rows[np.isclose(rows[name].astype(float), float(held))]
-        else:
-            rows = rows[rows[name].astype(str) == str(held)]
+    for name, value in held.items():
+        column = rows[name]
+        same = np.isclose(column.astype(float), float(value)) if pd.api.types.is_numeric_dtype(column) \
+            else column.astype(str) == str(value)
+        rows = rows[same]
     xs, ys = np.unique(ds[x].values), np.unique(ds[y].values)
     for mode, r in rows.iterrows():
         px, py = float(r[x]), float(r[y])

@@ -90,9 +90,10 @@ def bands(samples: pd.DataFrame, experiment: pd.Series | None = None, nominal: d
         values = samples[metric].dropna()
         lo, mid, hi = (values.quantile(q) if len(values) else np.nan for q in QUANTILES)
         corr = ranks[inputs].corrwith(ranks[metric]).dropna()
+        driver = corr.abs().idxmax() if len(corr) else ""
         row = {"metric": metric, "nominal": (nominal or {}).get(metric, np.nan), "p05": lo, "p50": mid, "p95": hi,
-               "samples_ok": int(len(values)), "driver": corr.abs().idxmax() if len(corr) else "",
-               "driver_spearman": float(corr[corr.abs().idxmax()]) if len(corr) else np.nan}
+               "samples_ok": int(len(values)), "driver": driver,
+               "driver_spearman": float(corr[driver]) if driver else np.nan}
         if experiment is not None and metric in experiment.index:
             measured = float(experiment[metric])
             unc = float(experiment.get(metric.replace("_mm", "_unc_mm"), 0.0) or 0.0)

@@ -39,6 +39,7 @@ import numpy as np
 import xarray as xr
 from scipy.spatial import cKDTree
 
+from beadsim.compare import wire_supply_area
 from beadsim.errors import SimulationFailed
 from beadsim.lammps_env import new_lammps
 from beadsim.materials import Material, get_material
@@ -105,7 +106,8 @@ def choose_numerics(params: dict, mat: Material, geom: SceneGeometry) -> Numeric
         c0 = max(c0, cohesion.min_sound_speed(mat))
     nu = mat.nu if params["viscosity_model"] == "morris" else params["artificial_viscosity"] * c0 * h / 8
     limits = {"acoustic": 0.1 * h / c0, "viscous": 0.125 * h * h / max(nu, 1e-30),
-              "thermal": 0.1 * dx * dx / (mat.diffusivity * params["melt_conductivity_factor"]), "gravity": 0.25 * math.sqrt(h / GRAVITY)}
+              "thermal": 0.1 * dx * dx / (mat.diffusivity * params["melt_conductivity_factor"]),
+              "gravity": 0.25 * math.sqrt(h / GRAVITY)}
     tait_rho0 = mat.rho
     if cohesion is not None:
         limits["capillary"] = cohesion.dt_limit(mat, dx, c0, params["artificial_viscosity"])
@@ -416,7 +418,7 @@ class BeadRun:
         self.out = Path(outdir)
         self.progress = progress
         self.mat = material or get_material(params["material"])
-        self.geom = build_geometry(params)
+        self.geom = build_geometry(params, self.mat)
         self.num = choose_numerics(params, self.mat, self.geom)
         self.thermal = Thermal(self.num.mass, self.mat, bool(params["latent_heat"]), params["mushy_range_K"])
         self.state = RunState()
@@ -819,10 +821,11 @@ class BeadRun:
     def _measure(self, temp: np.ndarray) -> dict:
         """Global diagnostics after a chunk."""
         st, lmp = self.state, self.lmp
-        liquid = self._types() == TYPE_LIQUID
+        x, types = self._x(), self._types()
+        liquid = types == TYPE_LIQUID
         rho = self._rho() / self.mat.rho
         speed = np.sqrt(np.einsum("ij,ij->i", self._v(), self._v()))
-        finite = bool(np.isfinite(self._x()).all() and np.isfinite(self._e()).all() and np.isfinite(speed).all())
+        finite = bool(np.isfinite(x).all() and np.isfinite(self._e()).all() and np.isfinite(speed).all())
         m = {"t": st.t, "step": st.step,
              "T_max": allreduce(lmp, float(temp.max()), "max"),
              "n_liquid": allreduce(lmp, int(liquid.sum())),
@@ -840,15 +843,13 @@ class BeadRun:
         m["E_residual"] = led.residual(now)
         e_in = led.beam + led.volumetric
         m["energy_error"] = m["E_residual"] / e_in if e_in > 0 else 0.0
-        xl = self._x()[liquid, 0]
-        m["pool_x_min"] = allreduce(lmp, float(xl.min()) if liquid.any() else np.inf, "min")
-        m["pool_x_max"] = allreduce(lmp, float(xl.max()) if liquid.any() else -np.inf, "max")
-        yl = np.abs(self._x()[liquid, 1])
-        m["pool_y_abs_max"] = allreduce(lmp, float(yl.max()) if liquid.any() else 0.0, "max")
-        zw = self._x()[self._types() == TYPE_WIRE, 2]
+        xl = x[liquid]  # extents of the melt; 'any' guards the empty reductions
+        m["pool_x_min"] = allreduce(lmp, float(xl[:, 0].min()) if liquid.any() else np.inf, "min")
+        m["pool_x_max"] = allreduce(lmp, float(xl[:, 0].max()) if liquid.any() else -np.inf, "max")
+        m["pool_y_abs_max"] = allreduce(lmp, float(np.abs(xl[:, 1]).max()) if liquid.any() else 0.0, "max")
+        m["melt_z_min"] = allreduce(lmp, float(xl[:, 2].min()) if liquid.any() else np.inf, "min")
+        zw = x[types == TYPE_WIRE, 2]
         m["wire_z_min"] = allreduce(lmp, float(zw.min()) if len(zw) else np.inf, "min")
-        zl = self._x()[liquid, 2]
-        m["melt_z_min"] = allreduce(lmp, float(zl.min()) if liquid.any() else np.inf, "min")
         return m
 
     def _watchdog(self, m: dict, expected_atoms: int) -> None:
@@ -962,7 +963,7 @@ class BeadRun:
 
     def _supply_mm2(self) -> float:
         p = self.p
-        return math.pi * (p["wire_diameter_mm"] / 2) ** 2 * p["wire_feed_mm_s"] / p["substrate_speed_mm_s"]
+        return wire_supply_area(p["wire_diameter_mm"], p["wire_feed_mm_s"], p["substrate_speed_mm_s"])
 
     def _report(self, m: dict) -> None:
         info = {"t": m["t"], "steps_per_s": m["steps_per_s"], "T_max": m["T_max"], "n_liquid": m["n_liquid"],
@@ -1098,7 +1099,6 @@ class BeadRun:
                 # steady state: the mean of the last three cross-sections (0.05 s apart)
                 from beadsim.sph import surface
 
-                out.pop("profile", None)
                 for key in ("mass_balance_ratio", "penetration_depth_mm"):
                     out[key] = float(np.nanmean([c.get(key, np.nan) for c in checks]))
                 y = self.profiles[-1][0]

@@ -105,7 +105,7 @@ def _snap(length: float, dx: float) -> float:
     return max(2, math.ceil(length / dx - 1e-9)) * dx
 
 
-def build_geometry(params: dict) -> SceneGeometry:
+def build_geometry(params: dict, material=None) -> SceneGeometry:
     """Size the modelled block and the wire from the case parameters.
 
     ``domain = auto``: the block spans the scanned track over ``sim_time_s`` plus ``domain_margin_mm`` behind
@@ -135,7 +135,7 @@ def build_geometry(params: dict) -> SceneGeometry:
     if params["domain"] == "window":
         frame = "beam"
         from beadsim.materials import get_material
-        mat = get_material(params["material"])
+        mat = material or get_material(params["material"])  # the run's material (its materials file)
         thermal = params["window_thermal_lengths"] * mat.diffusivity / vs
         front = _snap(beam_r + thermal, dx)
         rear = _snap(max(beam_r, pool_tail(params, mat)) + params["window_bead_mm"] * mm + 2 * dx, dx)

@@ -330,6 +330,5 @@ def fusion_width(pos, melted_mask, dx, x_window, z_surface=0.0):
     fused = np.isfinite(top) & np.isfinite(top_melt) & (np.nan_to_num(top_melt, nan=-np.inf) >= top - 0.5 * dx)
     if not fused.any():
         return 0.0
-    heights = np.where(fused, np.nan_to_num(top, nan=-np.inf), -np.inf)
-    run = _bead_run(np.where(fused, heights, np.nan), -np.inf)
+    run = _bead_run(np.where(fused, top, np.nan), -np.inf)  # fused bins have a finite top
     return (run.stop - run.start) * dx * 1e3
