@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from beadsim.analysis import loo_calibration, richardson
+from beadsim.compare import match_experiments
 from beadsim.dataset import build_dataset
 from beadsim.runner import run_case
 from beadsim.study import case_params, design
@@ -44,6 +45,15 @@ def test_leave_one_out_never_fits_a_mode_to_itself(tmp_path, experiments):
     assert (loo["width_err_rel_loo"] ** 2).sum() >= (loo["width_err_rel_fit"] ** 2).sum() - 1e-12
     # Width grows with absorbed power, so the calibrated efficiency is where mode 1's width is matched best.
     assert summary["width_rms_err_rel_loo"] < 0.5
+    # Another width metric (the SPH model fits its fused width): the predictions follow that metric's curve.
+    pool, summary_pool = loo_calibration(ds, experiments, "beam_efficiency", width_metric="pool_width_mm")
+    assert summary_pool["width_metric"] == "pool_width_mm"
+    index = {str(c): i for i, c in enumerate(ds["case"].values)}
+    for _, row in pool.iterrows():
+        mine = sorted((index[r] for r, m in match_experiments(ds, experiments).items() if m == row["mode"]),
+                      key=lambda i: ds["beam_efficiency"].values[i])
+        assert row["width_pred_loo_mm"] == pytest.approx(np.interp(
+            row["beam_efficiency_loo"], ds["beam_efficiency"].values[mine], ds["pool_width_mm"].values[mine]))
 
 
 def test_stability_classes():

@@ -59,3 +59,42 @@ def test_beam_frame_velocities_and_inflow_layer():
     assert not fixed.moving_window and fixed.beam_x(0.2) == pytest.approx(0.2 * fixed.substrate_speed)
     assert np.allclose(fixed.wire_velocity, [fixed.substrate_speed, 0, 0] - fixed.wire_feed * fixed.wire_axis)
     assert math.isclose(scene.wire_slice_pitch(g), scene.wire_slice_pitch(fixed))
+
+
+def _wire(g):
+    """Initial wire particles and their axial distance from the tip plane (beam at x = 0)."""
+    pos, s_last = scene.initial_wire(g)
+    s = (pos - np.array([0.0, 0.0, g.wire_height])) @ g.wire_axis
+    return pos, s, s_last
+
+
+@pytest.mark.parametrize("dx", [0.3, 0.4, 0.5])
+def test_intact_wire_stays_attached_and_a_cut_piece_is_detached(dx):
+    g = scene.build_geometry(window_case(resolution_mm=dx, wire_length_mm=4.0))
+    pos, s, s_last = _wire(g)
+    link = scene.wire_link_length(g)
+    assert not scene.detached_wire(pos, s, s_last, link).any()
+    # melt a slab two slices thick across the whole wire, 1 mm up the axis: everything below it is cut off
+    pitch = scene.wire_slice_pitch(g)
+    slices = np.round(s / pitch - 0.5).astype(int)
+    cut_slice = int(round(1e-3 / pitch))
+    keep = (slices < cut_slice) | (slices > cut_slice + 1)
+    cut = scene.detached_wire(pos[keep], s[keep], s_last, link)
+    assert np.array_equal(cut, slices[keep] < cut_slice)
+    # one melted slice with a single particle left standing keeps the tip attached through it
+    one = (slices != cut_slice) | (np.arange(len(s)) == np.flatnonzero(slices == cut_slice)[0])
+    assert not scene.detached_wire(pos[one], s[one], s_last, link).any()
+    # no particle at the feed end: nothing is released on doubtful evidence
+    top = slices < slices.max()
+    assert not scene.detached_wire(pos[top], s[top], s_last, link).any()
+
+
+@pytest.mark.parametrize("angle, height", [(45.0, 1.5), (30.0, 2.0), (70.0, 1.0)])
+def test_wire_landing_point_is_where_the_fed_tip_meets_the_surface(angle, height):
+    g = scene.build_geometry(window_case(resolution_mm=0.1, wire_angle_deg=angle, wire_height_mm=height))
+    tip = scene.wire_slice(g, 0.0, 0.0)  # the tip face, particles on a fine grid
+    low = tip[np.argmin(tip[:, 2])]
+    travel = low[2] / math.sin(g.wire_angle)  # along -axis until the lowest point touches z = 0
+    x_land = low[0] - travel * math.cos(g.wire_angle)
+    assert g.wire_landing_x() == pytest.approx(x_land, abs=g.dx)
+    assert np.allclose(g.wire_velocity_at(False), 0.0)  # held still relative to the beam before the feed starts

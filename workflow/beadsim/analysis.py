@@ -23,8 +23,10 @@ def _targets_for(mode: int, balance: pd.DataFrame) -> list[str]:
     return ["width", "height"] if bool(balance.loc[mode, "consistent"]) else ["width"]
 
 
-def response_curves(ds: xr.Dataset, exp: pd.DataFrame, parameter: str) -> dict[int, pd.DataFrame]:
-    """For each measured mode: the ok runs sorted by ``parameter`` with predicted width and height."""
+def response_curves(ds: xr.Dataset, exp: pd.DataFrame, parameter: str,
+                    width_metric: str = "bead_width_mm") -> dict[int, pd.DataFrame]:
+    """For each measured mode: the ok runs sorted by ``parameter`` with predicted width (``width_metric``) and
+    height."""
     matched = match_experiments(ds, exp)
     index = {str(c): i for i, c in enumerate(ds["case"].values)}
     curves: dict[int, list] = {}
@@ -33,18 +35,20 @@ def response_curves(ds: xr.Dataset, exp: pd.DataFrame, parameter: str) -> dict[i
         if ds["status"].values[i] != "ok":
             continue
         curves.setdefault(mode, []).append({parameter: float(ds[parameter].values[i]),
-                                            "width": float(ds["bead_width_mm"].values[i]),
+                                            "width": float(ds[width_metric].values[i]),
                                             "height": float(ds["bead_height_mm"].values[i])})
     return {m: pd.DataFrame(rows).sort_values(parameter).reset_index(drop=True) for m, rows in curves.items()}
 
 
 def loo_calibration(ds: xr.Dataset, exp: pd.DataFrame, parameter: str = "beam_efficiency",
-                    n_fine: int = 2001) -> tuple[pd.DataFrame, dict]:
+                    n_fine: int = 2001, width_metric: str = "bead_width_mm") -> tuple[pd.DataFrame, dict]:
     """Calibrate one parameter against Table 1 with leave-one-out cross-validation.
 
     The parameter's value for predicting mode m is the one that minimises the summed squared relative error of
     the *other* modes (width, and height where that bead passes its mass balance), with the metrics linearly
-    interpolated between the swept values. So no mode is predicted by a fit to itself.
+    interpolated between the swept values. So no mode is predicted by a fit to itself. The predicted width is
+    ``width_metric``: ``bead_width_mm`` (the bead's height profile), or ``fusion_width_mm`` (the molten top
+    surface) where the bead is too flat for a height threshold (SPH beads one or two particles high).
 
     Returns
     -------
@@ -54,7 +58,7 @@ def loo_calibration(ds: xr.Dataset, exp: pd.DataFrame, parameter: str = "beam_ef
     summary : dict
         All-modes fit value, RMS cross-validated relative errors of width and height.
     """
-    curves = response_curves(ds, exp, parameter)
+    curves = response_curves(ds, exp, parameter, width_metric)
     balance = measured_mass_balance(exp).set_index("mode")
     modes = sorted(curves)
     if len(modes) < 2:
@@ -95,6 +99,7 @@ def loo_calibration(ds: xr.Dataset, exp: pd.DataFrame, parameter: str = "beam_ef
     table = pd.DataFrame(rows)
     summary = {
         "parameter": parameter,
+        "width_metric": width_metric,
         "range_searched": [float(lo), float(hi)],
         f"{parameter}_all": best_all,
         f"{parameter}_all_interval": [float(near.min()), float(near.max())],

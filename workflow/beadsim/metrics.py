@@ -42,6 +42,8 @@ METRICS: dict[str, tuple[str, str]] = {
     "wall_time_s": ("s", "wall time of the model"),
     "density_min": ("1", "minimum liquid density / rho0"),
     "density_max": ("1", "maximum liquid density / rho0"),
+    "wire_feed_start_s": ("s", "process time the wire feed started (NaN: never)"),
+    "wire_released_particles": ("1", "unmelted wire particles cut off from the fed wire (fell free)"),
 }
 
 # String-valued outputs (not numbers).

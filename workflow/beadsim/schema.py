@@ -127,7 +127,14 @@ def build_schema() -> dict:
                         "additionalProperties": False,
                         "description": "fit one parameter to Table 1 with leave-one-out cross-validation "
                                        "(sweep it over the measured modes)",
-                        "properties": {"parameter": {"enum": numeric, "default": "beam_efficiency"}},
+                        "properties": {
+                            "parameter": {"enum": numeric, "default": "beam_efficiency"},
+                            "width_metric": {"enum": ["bead_width_mm", "fusion_width_mm"],
+                                             "default": "bead_width_mm",
+                                             "description": "predicted width compared with the measured one: "
+                                                            "the bead profile's, or the fused top surface's "
+                                                            "(flat SPH beads)"},
+                        },
                     },
                     "stability": {
                         "type": "object",

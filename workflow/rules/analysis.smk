@@ -18,6 +18,7 @@ rule calibrate_parameter:
         ),
     params:
         parameter=lookup(dpath="analysis/calibration/parameter", within=config, default="beam_efficiency"),
+        width_metric=lookup(dpath="analysis/calibration/width_metric", within=config, default="bead_width_mm"),
     conda:
         "../../envs/beadsim.yaml"
     log:

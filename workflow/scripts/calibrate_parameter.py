@@ -11,10 +11,10 @@ from beadsim.study import load_experiments
 configure_logging(snakemake.log[0])
 ds = xr.load_dataset(snakemake.input.dataset)
 exp = load_experiments(snakemake.input.experiments)
-parameter = snakemake.params.parameter
-table, summary = loo_calibration(ds, exp, parameter)
+parameter, width = snakemake.params.parameter, snakemake.params.width_metric
+table, summary = loo_calibration(ds, exp, parameter, width_metric=width)
 with atomic_path(snakemake.output.table) as tmp:
     table.to_csv(tmp, index=False)
 write_json(snakemake.output.summary, summary)
-save_figure(calibration_plot(response_curves(ds, exp, parameter), table, exp, parameter, ds[parameter].attrs),
+save_figure(calibration_plot(response_curves(ds, exp, parameter, width), table, exp, parameter, ds[parameter].attrs),
             snakemake.output.figure)

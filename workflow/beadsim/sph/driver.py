@@ -44,8 +44,8 @@ from beadsim.errors import SimulationFailed
 from beadsim.lammps_env import new_lammps
 from beadsim.materials import Material, get_material
 from beadsim.sph import scene
-from beadsim.sph.scene import (TYPE_LIQUID, TYPE_RESOLIDIFIED, TYPE_SUBSTRATE, TYPE_WIRE, SceneGeometry,
-                               build_geometry)
+from beadsim.sph.scene import (FLUID_TYPES, TYPE_FALLING, TYPE_LIQUID, TYPE_RESOLIDIFIED, TYPE_SUBSTRATE,
+                               TYPE_WIRE, SceneGeometry, build_geometry)
 
 log = logging.getLogger("beadsim.sph")
 
@@ -190,6 +190,15 @@ def allreduce(lmp, value, op: str = "sum"):
         MPI.COMM_WORLD.Allreduce(send, out, op=mpi_op)
         return out
     return MPI.COMM_WORLD.allreduce(value, op=mpi_op)
+
+
+def allgather_rows(lmp, value: np.ndarray) -> np.ndarray:
+    """Rows of an array from every MPI rank, concatenated in rank order (the array itself on one rank)."""
+    if lmp.extract_setting("world_size") == 1:
+        return value
+    from mpi4py import MPI
+
+    return np.concatenate(MPI.COMM_WORLD.allgather(np.ascontiguousarray(value)))
 
 
 def lucy_kernel(r: np.ndarray, h: float) -> np.ndarray:
@@ -388,6 +397,7 @@ class RunState:
     t_max: float = 0.0
     v_max: float = 0.0
     inflow_x: float = float("nan")
+    feed_start_t: float = float("nan")  # process time the wire feed started (NaN: not yet)
 
 
 class PerId:
@@ -398,6 +408,7 @@ class PerId:
         self.max_t = np.zeros(n + 1)
         self.face_area = np.zeros(n + 1)
         self.wire_origin = np.zeros(n + 1, dtype=bool)
+        self.released = np.zeros(n + 1, dtype=bool)
 
     def grow(self, n: int) -> None:
         """Make room for ids up to n (with headroom, ids only grow)."""
@@ -406,6 +417,7 @@ class PerId:
             self.max_t = np.concatenate([self.max_t, np.zeros(extra)])
             self.face_area = np.concatenate([self.face_area, np.zeros(extra)])
             self.wire_origin = np.concatenate([self.wire_origin, np.zeros(extra, dtype=bool)])
+            self.released = np.concatenate([self.released, np.zeros(extra, dtype=bool)])
 
 
 # ----------------------------------------------------------------------------------------------- driver
@@ -480,6 +492,8 @@ class BeadRun:
             cmd(f"velocity all set {g.substrate_velocity[0]:.9g} 0 0 units box")
             self.state.inflow_x = g.x_hi - d / 2
         self.state.next_id = n_sub + 1
+        if self.p["wire_feed_start"] == "immediate":
+            self.state.feed_start_t = 0.0
         wire, s_last = scene.initial_wire(g)
         self.state.wire_s_last = s_last
         self._create_wire_atoms(wire)
@@ -497,7 +511,7 @@ class BeadRun:
         for x, y, z in pos:
             self.deck(f"create_atoms {TYPE_WIRE} single {x:.9g} {y:.9g} {z:.9g} units box")
         last = first + len(pos) - 1
-        v = self.geom.wire_velocity
+        v = self._wire_velocity()
         e0 = self.thermal.energy(self.T0)
         self.deck(f"set atom {first}*{last} sph/rho {self.mat.rho:.9g} sph/cv {self.thermal.heat_capacity:.9g} "
                   f"sph/e {e0:.9g} vx {v[0]:.9g} vy {v[1]:.9g} vz {v[2]:.9g}")
@@ -525,13 +539,14 @@ class BeadRun:
                           f"{self.mat.diffusivity * f:.9g} {h:.9g}")
             if self.p["melt_interface_conductivity"] == "harmonic":
                 d_int = self.mat.diffusivity * 2 * f / (1 + f)
-                for other in (TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED):
+                for other in (TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED, TYPE_FALLING):
                     i, j = sorted((TYPE_LIQUID, other))
                     coeffs.append(f"pair_coeff {i} {j} sph/heatconduction {d_int:.9g} {h:.9g}")
         model = self.num.cohesion
         if model is not None:  # surface tension: one more overlay sub-style, liquid-liquid and liquid-solid
             styles.append(model.pair_style_tokens())
-            coeffs += model.pair_coeff_commands([TYPE_LIQUID], [TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED],
+            coeffs += model.pair_coeff_commands([TYPE_LIQUID],
+                                                [TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED, TYPE_FALLING],
                                                 table_file=self.out / "tension.table")
         return styles, coeffs
 
@@ -547,10 +562,11 @@ class BeadRun:
         cmd("compute rho all sph/rho/atom")
         cmd("compute e all sph/e/atom")
         cmd("compute T all sph/t/atom")
+        # falling (detached) wire moves with the fluid whatever its temperature
         if self.num.cohesion is None:
-            cmd(f"variable frozen atom c_T<{self.mat.T_melt:.9g}")
+            cmd(f"variable frozen atom c_T<{self.mat.T_melt:.9g}&&type!={TYPE_FALLING}")
         else:  # cohesion acts by type: melt and freeze at chunk ends, when the types switch
-            cmd(f"variable frozen atom type!={TYPE_LIQUID}")
+            cmd(f"variable frozen atom type!={TYPE_LIQUID}&&type!={TYPE_FALLING}")
         cmd("group frozen dynamic all var frozen every 1")
         if self.geom.moving_window and not self.lmp.has_id("region", "behind"):
             cmd(f"region behind block INF {self.geom.x_lo:.9g} INF INF INF INF units box")
@@ -613,9 +629,36 @@ class BeadRun:
         return self.lmp.numpy.extract_atom("type", nelem=self._nlocal())
 
     # ---- between chunks
+    @property
+    def feeding(self) -> bool:
+        """True once the wire feed has started."""
+        return bool(np.isfinite(self.state.feed_start_t))
+
+    def _wire_velocity(self) -> np.ndarray:
+        return self.geom.wire_velocity_at(self.feeding)
+
+    def _start_feed_on_pool(self) -> None:
+        """``wire_feed_start = pool``: start the feed once melt lies within a wire radius + dx of the point
+        where the wire tip will land (:meth:`SceneGeometry.wire_landing_x`); set the wire moving at once."""
+        g, d = self.geom, self.geom.dx
+        x, types = self._x(), self._types()
+        land = g.beam_x(self.state.t) + g.wire_landing_x()
+        near = (types == TYPE_LIQUID) & (np.hypot(x[:, 0] - land, x[:, 1]) <= g.wire_radius + d) & (x[:, 2] > -2 * d)
+        if allreduce(self.lmp, int(near.sum())) == 0:
+            return
+        self.state.feed_start_t = self.state.t
+        v = self._v()
+        v[types == TYPE_WIRE] = self._wire_velocity()
+        if self.rank0:
+            log.info("t %.4f s: melt under the wire tip, the wire feed starts", self.state.t)
+
     def _feed_wire(self) -> bool:
         """Advance the wire feed end; create the slices that entered. True if atoms were created."""
         g, st = self.geom, self.state
+        if not self.feeding:
+            self._start_feed_on_pool()
+            if not self.feeding:
+                return False
         st.wire_s_last -= g.wire_feed * self.chunk * self.num.dt
         created = False
         pitch = scene.wire_slice_pitch(g)
@@ -702,10 +745,13 @@ class BeadRun:
         wire = types == TYPE_WIRE
         new_types = np.where(liquid, TYPE_LIQUID, np.where(melted, TYPE_RESOLIDIFIED,
                                                            np.where(wire, TYPE_WIRE, TYPE_SUBSTRATE)))
+        if self.p["wire_detach"] == "fall":
+            self._release_detached(ids, new_types == TYPE_WIRE)
+            new_types[self.per_id.released[ids] & ~melted] = TYPE_FALLING
         changed = allreduce(self.lmp, int((new_types != types).sum())) > 0
         types[:] = new_types
-        frozen = ~liquid
-        target = np.where(types[frozen, None] == TYPE_WIRE, self.geom.wire_velocity, self.geom.substrate_velocity)
+        frozen = ~liquid & (new_types != TYPE_FALLING)
+        target = np.where(types[frozen, None] == TYPE_WIRE, self._wire_velocity(), self.geom.substrate_velocity)
         # kinetic energy removed by freezing a particle in place becomes heat of that particle
         ke_old = 0.5 * self.num.mass * np.einsum("ij,ij->i", v[frozen], v[frozen])
         ke_new = 0.5 * self.num.mass * np.einsum("ij,ij->i", target, target)
@@ -714,6 +760,23 @@ class BeadRun:
         if self.p["solid_density_reset"]:
             self._rho()[frozen] = self.mat.rho
         return temp, changed
+
+    def _release_detached(self, ids: np.ndarray, wire: np.ndarray) -> None:
+        """Mark the unmelted wire particles cut off from the feed end as released (on every rank: the
+        connectivity is found on the gathered wire of all ranks, see :func:`scene.detached_wire`)."""
+        g = self.geom
+        x = self._x()[wire]
+        gid = allgather_rows(self.lmp, ids[wire])
+        pos = allgather_rows(self.lmp, x)
+        if len(gid) == 0:
+            return
+        s = (pos - np.array([g.beam_x(self.state.t), 0.0, g.wire_height])) @ g.wire_axis
+        cut = scene.detached_wire(pos, s, self.state.wire_s_last, scene.wire_link_length(g))
+        if cut.any():
+            self.per_id.released[gid[cut]] = True
+            if self.rank0:
+                log.info("t %.4f s: %d unmelted wire particles cut off from the feed end fall free (lowest at "
+                         "z %.2f mm)", self.state.t, int(cut.sum()), pos[cut, 2].min() * 1e3)
 
     def _shepard(self, liquid: np.ndarray) -> None:
         """Shepard-normalised density of the liquid particles: rho_i = sum m W / sum (m / rho_j) W."""
@@ -746,7 +809,7 @@ class BeadRun:
         """
         nlocal = self._nlocal()
         nall = nlocal + self.lmp.extract_setting("nghost")
-        liquid = np.flatnonzero(self.lmp.numpy.extract_atom("type", nelem=nall) == TYPE_LIQUID)
+        liquid = np.flatnonzero(np.isin(self.lmp.numpy.extract_atom("type", nelem=nall), FLUID_TYPES))
         if len(liquid) == 0:
             return
         x = self.lmp.numpy.extract_atom("x", nelem=nall, dim=3)
@@ -823,16 +886,18 @@ class BeadRun:
         st, lmp = self.state, self.lmp
         x, types = self._x(), self._types()
         liquid = types == TYPE_LIQUID
+        fluid = np.isin(types, FLUID_TYPES)
         rho = self._rho() / self.mat.rho
         speed = np.sqrt(np.einsum("ij,ij->i", self._v(), self._v()))
         finite = bool(np.isfinite(x).all() and np.isfinite(self._e()).all() and np.isfinite(speed).all())
         m = {"t": st.t, "step": st.step,
              "T_max": allreduce(lmp, float(temp.max()), "max"),
              "n_liquid": allreduce(lmp, int(liquid.sum())),
+             "n_falling": allreduce(lmp, int((types == TYPE_FALLING).sum())),
              "n_atoms": int(lmp.get_natoms()),
-             "rho_min": allreduce(lmp, float(rho[liquid].min()) if liquid.any() else 1.0, "min"),
-             "rho_max": allreduce(lmp, float(rho[liquid].max()) if liquid.any() else 1.0, "max"),
-             "v_max": allreduce(lmp, float(speed[liquid].max()) if liquid.any() else 0.0, "max"),
+             "rho_min": allreduce(lmp, float(rho[fluid].min()) if fluid.any() else 1.0, "min"),
+             "rho_max": allreduce(lmp, float(rho[fluid].max()) if fluid.any() else 1.0, "max"),
+             "v_max": allreduce(lmp, float(speed[fluid].max()) if fluid.any() else 0.0, "max"),
              "finite": allreduce(lmp, int(not finite)) == 0}
         m.update(self._energy_now())
         led = st.ledger
@@ -867,7 +932,9 @@ class BeadRun:
         elif m["wire_z_min"] < min(-2 * self.geom.dx, m["melt_z_min"] - self.geom.dx):
             # a wire dipping into the pool melts there; one pushed below the pool ploughs through solid metal
             reason = (f"solid wire reached {-m['wire_z_min'] * 1e3:.2f} mm below the surface, below the melt "
-                      f"{where}: neither the beam nor the pool melts the wire as fast as it is fed (stubbing)")
+                      f"{where}: neither the beam nor the pool melts the wire as fast as it is fed (stubbing)"
+                      + ("; wire_feed_start: pool starts the feed on a formed pool"
+                         if self.p["wire_feed_start"] == "immediate" else ""))
         elif m["rho_min"] < 1 - tol or m["rho_max"] > 1 + tol:
             reason = (f"liquid density {m['rho_min']:.3f}-{m['rho_max']:.3f} rho0 outside 1 +- {tol:g} {where}")
         elif m["v_max"] > self.speed_limit:
@@ -920,7 +987,7 @@ class BeadRun:
             temp, changed = self._phase_update()
             need_setup = changed and self.num.cohesion is not None
             if p["shepard_interval"] and st.steps_since_shepard >= p["shepard_interval"]:
-                self._shepard(self._types() == TYPE_LIQUID)
+                self._shepard(np.isin(self._types(), FLUID_TYPES))
                 st.steps_since_shepard = 0
             self._compression_floor()
             self._cap_temperature()
@@ -945,6 +1012,9 @@ class BeadRun:
             if st.t >= st.t_next_restart - 0.5 * dt_chunk:
                 self.checkpoint()
                 st.t_next_restart += p["restart_interval_s"]
+        if not self.feeding:
+            raise SimulationFailed(f"no melt reached the wire's landing point by t={st.t:.4g} s: the wire feed "
+                                   "never started (wire_feed_start: pool)", self._metrics(partial=True))
         if m is not None and (not self.series or self.series[-1]["t"] != m["t"]):
             m["steps_per_s"] = steps_block / max(time.perf_counter() - wall_block, 1e-9)
             self.series.append(m)
@@ -1041,6 +1111,7 @@ class BeadRun:
         os.replace(rdir / "restart.tmp.bin", rdir / "restart.bin")
         np.savez(rdir / "state.tmp.npz", state=json.dumps(asdict(self.state)), max_t=max_t,
                  face_area=self.per_id.face_area, wire_origin=self.per_id.wire_origin,
+                 released=self.per_id.released,
                  series=json.dumps(self.series),
                  particle_steps=self.particle_steps)
         os.replace(rdir / "state.tmp.npz", rdir / "state.npz")
@@ -1050,10 +1121,13 @@ class BeadRun:
         data = np.load(rdir / "state.npz")
         raw = json.loads(str(data["state"]))
         raw["ledger"] = Ledger(**raw["ledger"])
+        raw.setdefault("feed_start_t", 0.0)  # checkpoints from before wire_feed_start fed from the start
         self.state = RunState(**raw)
         self.per_id.max_t = np.array(data["max_t"])
         self.per_id.face_area = np.array(data["face_area"])
         self.per_id.wire_origin = np.array(data["wire_origin"]) if "wire_origin" in data else \
+            np.zeros(len(self.per_id.max_t), dtype=bool)
+        self.per_id.released = np.array(data["released"]) if "released" in data else \
             np.zeros(len(self.per_id.max_t), dtype=bool)
         self.series = json.loads(str(data["series"]))
         self.particle_steps = float(data["particle_steps"])
@@ -1089,6 +1163,8 @@ class BeadRun:
                "absorbed_power_W": p["beam_power_W"] * p["beam_efficiency"]}
         area_w = math.pi * (p["wire_diameter_mm"] / 2) ** 2
         out["wire_supply_area_mm2"] = self._supply_mm2()
+        out["wire_released_particles"] = int(self.per_id.released.sum())
+        out["wire_feed_start_s"] = st.feed_start_t
         out["python_time_share_bead_checks"] = self.bead_time / wall if wall > 0 else np.nan
         out["wire_melt_power_W"] = (self.mat.rho * area_w * 1e-6 * p["wire_feed_mm_s"] * 1e-3
                                     * (self.mat.cp * (self.mat.T_melt - self.T0) + self.mat.latent_heat))
