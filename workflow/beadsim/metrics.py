@@ -44,6 +44,7 @@ METRICS: dict[str, tuple[str, str]] = {
     "density_max": ("1", "maximum liquid density / rho0"),
     "wire_feed_start_s": ("s", "process time the wire feed started (NaN: never)"),
     "wire_released_particles": ("1", "unmelted wire particles cut off from the fed wire (fell free)"),
+    "wire_landed_particles": ("1", "released wire particles that landed on solid before melting"),
 }
 
 # String-valued outputs (not numbers).

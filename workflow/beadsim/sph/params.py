@@ -66,13 +66,14 @@ SPH_PARAMETERS: list[Param] = [
           "new slices enter", exclusive_minimum=0, maximum=50, short="Lw", models=_SPH,
           long_name="modelled wire length"),
     Param("wire_feed_start", "string", "immediate", "", "when the wire feed starts: immediate (at t = 0, as in "
-          "the paper) or pool (once the substrate where the wire tip will land has melted, as an operator starts "
-          "the feed on a formed pool; the wire waits still above it until then). A cold wire pushed into cold "
+          "the paper) or pool (once the pool where the wire tip will land holds a wire cross-section of melt, as "
+          "an operator starts the feed on a formed pool; the wire waits still above it until then). A cold wire pushed into cold "
           "metal stubs: a wide scan ring leaves the tip unheated (mode 3, D 3 mm)", enum=("immediate", "pool"),
           short="wfs", models=_SPH, long_name="wire feed start"),
     Param("wire_detach", "string", "fall", "", "unmelted wire cut off from the fed wire by the beam (a scan ring "
           "wider than the wire crosses it above the tip): fall (no longer fed; it falls and moves with the melt "
-          "under SPH forces and gravity until it melts) or rigid (fed on with the wire, the behaviour before "
+          "under SPH forces and gravity until it melts, or until it touches solid substrate or bead, where it "
+          "stays as solid moving with the substrate until it melts) or rigid (fed on with the wire, the behaviour before "
           "2026-11, which pushes the piece into the substrate)", enum=("fall", "rigid"), short="wdet",
           models=_SPH, long_name="detached wire"),
     Param("beam_layers", "integer", 2, "1", "particle layers below the top of each column seen from above "
