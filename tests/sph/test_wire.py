@@ -13,6 +13,7 @@ import xarray as xr
 from beadsim.errors import SimulationFailed
 from beadsim.parameters import defaults
 from beadsim.sph.driver import run_case
+from beadsim.sph.scene import build_geometry, detached_wire, wire_link_length
 
 
 def mode3(**over) -> dict:
@@ -53,3 +54,8 @@ def test_feed_started_on_the_pool_runs_and_the_wire_waits_for_it(tmp_path):
         gap = np.min(np.linalg.norm(atoms[falling, None, 2:5] - atoms[None, solid, 2:5], axis=2), axis=1)
         assert gap.min() > 0.9 * dx
     assert atoms[:, 4].min() > -3e-3 - dx  # nothing below the block (domain_depth_mm 3)
+    # every particle still typed wire (and so fed) hangs on the feed end: cut-off pieces never stay wire
+    g = build_geometry(mode3())
+    wire = atoms[atoms[:, 1] == 2, 2:5]
+    s_axis = (wire - np.array([0.0, 0.0, g.wire_height])) @ g.wire_axis
+    assert not detached_wire(wire, s_axis, s_axis.max(), wire_link_length(g)).any()

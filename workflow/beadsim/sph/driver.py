@@ -751,12 +751,14 @@ class BeadRun:
         new_types = np.where(liquid, TYPE_LIQUID, np.where(melted, TYPE_RESOLIDIFIED,
                                                            np.where(wire, TYPE_WIRE, TYPE_SUBSTRATE)))
         if self.p["wire_detach"] == "fall":
-            self._release_detached(ids, new_types == TYPE_WIRE)
-            falling = self.per_id.released[ids] & ~self.per_id.landed[ids] & ~melted
+            released = self.per_id.released
+            self._release_detached(ids, (new_types == TYPE_WIRE) & ~released[ids])
+            falling = released[ids] & ~self.per_id.landed[ids] & ~melted
             if allreduce(self.lmp, int(falling.sum())):
                 self._land(ids, falling)
                 falling &= ~self.per_id.landed[ids]
-            new_types[falling] = TYPE_FALLING  # landed and unmelted: substrate-like solid (the rule above)
+            new_types[released[ids] & ~melted] = TYPE_SUBSTRATE  # landed: solid moving with the substrate
+            new_types[falling] = TYPE_FALLING
         changed = allreduce(self.lmp, int((new_types != types).sum())) > 0
         types[:] = new_types
         frozen = ~liquid & (new_types != TYPE_FALLING)
