@@ -59,3 +59,28 @@ def test_feed_started_on_the_pool_runs_and_the_wire_waits_for_it(tmp_path):
     wire = atoms[atoms[:, 1] == 2, 2:5]
     s_axis = (wire - np.array([0.0, 0.0, g.wire_height])) @ g.wire_axis
     assert not detached_wire(wire, s_axis, s_axis.max(), wire_link_length(g)).any()
+
+
+def test_spatter_leaving_the_block_is_deleted_with_its_energy_in_the_ledger(tmp_path):
+    """A molten droplet beyond the side of the block (the droplets that skate off over the cold substrate) is
+    deleted before it leaves the box, its energy is booked, and the ledger residual does not move; past
+    ``spatter_limit`` the watchdog fails the run."""
+    from beadsim.sph.driver import BeadRun
+
+    run = BeadRun(mode3(spatter_limit=0), tmp_path)
+    run.open(resume=False)
+    g = run.geom
+    n0 = int(run.lmp.get_natoms())
+    victim = int(run._ids()[0])
+    run.deck(f"set atom {victim} type 3 x 0 y {g.y_hi + 3 * g.dx:.9g} z 0.0005 vy 0.05")
+    run.deck("run 0 post no")
+    now = sum(run._energy_now().values())
+    assert run._remove_spatter()
+    assert int(run.lmp.get_natoms()) == n0 - 1 and run.state.n_ejected == 1
+    # the energy that left with the droplet is what the ledger booked, so the residual does not move
+    assert run.state.ledger.ejected > 0
+    assert now - sum(run._energy_now().values()) == pytest.approx(run.state.ledger.ejected, rel=1e-9)
+    assert not run._remove_spatter()  # nothing left outside
+    m = run._measure(run.thermal.temperature(run._e()))
+    with pytest.raises(SimulationFailed, match="spatter"):
+        run._watchdog(m, int(run.lmp.get_natoms()))

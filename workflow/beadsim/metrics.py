@@ -42,6 +42,7 @@ METRICS: dict[str, tuple[str, str]] = {
     "wall_time_s": ("s", "wall time of the model"),
     "density_min": ("1", "minimum liquid density / rho0"),
     "density_max": ("1", "maximum liquid density / rho0"),
+    "spatter_particles": ("1", "fluid particles deleted after leaving the modelled block"),
     "wire_feed_start_s": ("s", "process time the wire feed started (NaN: never)"),
     "wire_released_particles": ("1", "unmelted wire particles cut off from the fed wire (fell free)"),
     "wire_landed_particles": ("1", "released wire particles that landed on solid before melting"),

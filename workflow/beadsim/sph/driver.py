@@ -373,11 +373,12 @@ class Ledger:
     initial: float = 0.0
     advected_in: float = 0.0
     advected_out: float = 0.0
+    ejected: float = 0.0  # internal + kinetic + potential energy of spatter deleted outside the block
 
     def residual(self, now: float) -> float:
         """Energy present minus what the ledger says should be present (J)."""
         return now - (self.initial + self.beam + self.volumetric + self.wire_in - self.evaporated - self.boundary
-                      + self.advected_in - self.advected_out)
+                      + self.advected_in - self.advected_out - self.ejected)
 
 
 @dataclass
@@ -398,6 +399,7 @@ class RunState:
     v_max: float = 0.0
     inflow_x: float = float("nan")
     feed_start_t: float = float("nan")  # process time the wire feed started (NaN: not yet)
+    n_ejected: int = 0  # spatter particles deleted outside the block
 
 
 class PerId:
@@ -733,6 +735,33 @@ class BeadRun:
             self.deck("delete_atoms region behind compress no")
         return True
 
+    def _remove_spatter(self) -> bool:
+        """Delete fluid particles that left the modelled block (two spacings beyond its sides, front or bottom,
+        or at the top of the box): droplets skating off over the cold substrate, which would otherwise leave the
+        box and be lost. Their energy goes into the ledger and their number into ``spatter_particles``; the
+        watchdog fails the run beyond ``spatter_limit``. True if atoms were deleted."""
+        g, d = self.geom, self.geom.dx
+        x, v, e, types = self._x(), self._v(), self._e(), self._types()
+        out = np.isin(types, FLUID_TYPES) & (
+            (x[:, 0] > g.x_hi + 2 * d) | (x[:, 0] < g.x_lo - 2 * d) | (np.abs(x[:, 1]) > g.y_hi + 2 * d)
+            | (x[:, 2] < g.z_lo - 2 * d) | (x[:, 2] > g.box_z_hi - d / 2))
+        if g.moving_window:  # the rear face deletes everything behind it already
+            out &= x[:, 0] >= g.x_lo
+        gone = allgather_rows(self.lmp, self._ids()[out])
+        if len(gone) == 0:
+            return False
+        m = self.num.mass
+        energy = float(e[out].sum() + 0.5 * m * np.einsum("ij,ij->", v[out], v[out]) + m * GRAVITY * x[out, 2].sum())
+        self.state.ledger.ejected += allreduce(self.lmp, energy)
+        self.state.n_ejected += len(gone)
+        if self.rank0:
+            log.info("t %.4f s: %d fluid particles left the block (spatter), deleted: %d so far", self.state.t,
+                     len(gone), self.state.n_ejected)
+        self.deck("group spatter id " + " ".join(str(int(i)) for i in gone))
+        self.deck("delete_atoms group spatter compress no")
+        self.deck("group spatter delete")
+        return True
+
     def _phase_update(self) -> tuple[np.ndarray, bool]:
         """Temperatures, types, frozen velocities and densities after a chunk.
 
@@ -929,7 +958,7 @@ class BeadRun:
         led = st.ledger
         m.update(E_beam=led.beam, E_volumetric=led.volumetric, E_wire_in=led.wire_in,
                  E_evaporated=led.evaporated, E_boundary=led.boundary, E_advected_in=led.advected_in,
-                 E_advected_out=led.advected_out)
+                 E_advected_out=led.advected_out, E_ejected=led.ejected)
         now = m["E_internal"] + m["E_kinetic"] + m["E_potential"] + m.get("E_cohesion", 0.0)
         m["E_residual"] = led.residual(now)
         e_in = led.beam + led.volumetric
@@ -951,6 +980,9 @@ class BeadRun:
             reason = f"non-finite position, velocity or energy {where}"
         elif m["n_atoms"] != expected_atoms:
             reason = f"{expected_atoms - m['n_atoms']} particles lost (left the box) {where}"
+        elif self.state.n_ejected > self.p["spatter_limit"]:
+            reason = (f"{self.state.n_ejected} fluid particles left the modelled block as spatter {where}, more "
+                      f"than spatter_limit {self.p['spatter_limit']}")
         elif self.geom.moving_window and "y_hi" in self.geom.cut_faces and \
                 m["pool_y_abs_max"] > self.geom.y_hi:
             reason = (f"melt reached the side face of the moving window (|y| {m['pool_y_abs_max'] * 1e3:.2f} mm of "
@@ -992,6 +1024,7 @@ class BeadRun:
         while st.t < self.t_end - 0.5 * dt_chunk:
             need_setup |= self._feed_wire()
             need_setup |= self._advect_window()
+            need_setup |= self._remove_spatter()
             bx = self.geom.beam_x(st.t)
             st.ledger.beam += deposit_beam(
                 self.lmp, p, self.geom, self._x(), self._e(), power * dt_chunk, bx, st.t, st.t + dt_chunk)
@@ -1187,6 +1220,7 @@ class BeadRun:
                "density_max": st.rho_max, "energy_in_J": st.ledger.beam,
                "energy_balance_error": last.get("energy_error", np.nan),
                "evaporated_energy_J": st.ledger.evaporated, "boundary_heat_loss_J": st.ledger.boundary,
+               "spatter_particles": st.n_ejected,
                "absorbed_power_W": p["beam_power_W"] * p["beam_efficiency"]}
         area_w = math.pi * (p["wire_diameter_mm"] / 2) ** 2
         out["wire_supply_area_mm2"] = self._supply_mm2()

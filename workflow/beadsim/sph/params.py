@@ -98,6 +98,9 @@ SPH_PARAMETERS: list[Param] = [
           "[1 - tol, 1 + tol] rho0", exclusive_minimum=0, maximum=1, short="rtol", models=_SPH),
     Param("speed_limit_m_s", "number", 0.0, "m s-1", "watchdog: fail above this particle speed; 0 = half the "
           "sound speed", minimum=0, maximum=1000, short="vlim", models=_SPH),
+    Param("spatter_limit", "integer", 10, "1", "watchdog: fluid particles that may leave the modelled block "
+          "(droplets skating off over the cold substrate; deleted, their energy kept in the ledger) before the "
+          "run fails", minimum=0, maximum=100000, short="splim", models=_SPH, long_name="spatter limit"),
     Param("energy_tolerance", "number", 0.05, "1", "watchdog: fail when the energy balance error exceeds this "
           "fraction of the beam energy delivered", exclusive_minimum=0, maximum=1, short="etol", models=_SPH),
 ]
