@@ -56,6 +56,31 @@ def test_leave_one_out_never_fits_a_mode_to_itself(tmp_path, experiments):
             row["beam_efficiency_loo"], ds["beam_efficiency"].values[mine], ds["pool_width_mm"].values[mine]))
 
 
+def test_leave_one_out_searches_each_fit_over_its_own_modes(tmp_path, experiments):
+    """Mode 3 has an ok run at one value only (its others failed, as SPH runs that stub): the fits that use mode 3
+    are pinned to that value, the fit that leaves it out searches the whole range, and mode 3 is not predicted
+    outside the one value it was run at."""
+    cfg = {"study": "cal", "sweep": [{"cases": [{"experiment": m} for m in (1, 2, 3)],
+                                      "grid": {"beam_efficiency": [0.3, 0.6, 0.9]}}]}
+    table = design(cfg, experiments)
+    results = []
+    for run_id in table.index:
+        run_case(case_params(table, run_id), tmp_path / run_id, run_id=run_id)
+        results.append(tmp_path / run_id / "result.json")
+    ds = build_dataset(results, None, cfg, table)
+    mode = match_experiments(ds, experiments)
+    keep = [i for i, c in enumerate(ds["case"].values)
+            if mode[str(c)] != 3 or ds["beam_efficiency"].values[i] == 0.9]
+    loo, summary = loo_calibration(ds.isel(case=keep), experiments, "beam_efficiency")
+    rows = loo.set_index("mode")
+    assert summary["range_searched"] == [0.9, 0.9] and summary["ranges_per_mode"][1] == [0.3, 0.9]
+    assert rows.loc[1, "beam_efficiency_loo"] == rows.loc[2, "beam_efficiency_loo"] == 0.9
+    full, _ = loo_calibration(ds, experiments, "beam_efficiency")
+    assert rows.loc[3, "beam_efficiency_loo"] == full.set_index("mode").loc[3, "beam_efficiency_loo"]
+    if rows.loc[3, "beam_efficiency_loo"] != 0.9:
+        assert np.isnan(rows.loc[3, "width_pred_loo_mm"])
+
+
 def test_stability_classes():
     from beadsim.analysis import stability_class
 

@@ -46,7 +46,10 @@ def loo_calibration(ds: xr.Dataset, exp: pd.DataFrame, parameter: str = "beam_ef
 
     The parameter's value for predicting mode m is the one that minimises the summed squared relative error of
     the *other* modes (width, and height where that bead passes its mass balance), with the metrics linearly
-    interpolated between the swept values. So no mode is predicted by a fit to itself. The predicted width is
+    interpolated between the swept values. So no mode is predicted by a fit to itself. Each fit searches the range
+    swept (with ok runs) by every mode it fits, and the left-out mode is predicted only inside its own range (NaN
+    outside it, no extrapolation), so one mode whose runs failed at some values does not narrow the others' fits.
+    The predicted width is
     ``width_metric``: ``bead_width_mm`` (the bead's height profile), or ``fusion_width_mm`` (the molten top
     surface) where the bead is too flat for a height threshold (SPH beads one or two particles high).
 
@@ -63,36 +66,47 @@ def loo_calibration(ds: xr.Dataset, exp: pd.DataFrame, parameter: str = "beam_ef
     modes = sorted(curves)
     if len(modes) < 2:
         raise ValueError(f"calibration needs runs of at least two measured modes; found {modes}")
-    lo = max(c[parameter].min() for c in curves.values())
-    hi = min(c[parameter].max() for c in curves.values())
-    grid = np.linspace(lo, hi, n_fine)
+
+    def span(fit_modes):
+        """Parameter values swept (ok runs) in every one of fit_modes: no extrapolation of any curve."""
+        return (max(curves[m][parameter].min() for m in fit_modes),
+                min(curves[m][parameter].max() for m in fit_modes))
 
     def pred(mode, q, values):
         c = curves[mode]
-        return np.interp(values, c[parameter], c[q])
+        inside = (values >= c[parameter].min()) & (values <= c[parameter].max())
+        return np.where(inside, np.interp(values, c[parameter], c[q]), np.nan)
 
-    def objective(fit_modes):
+    def fit(fit_modes):
+        """Best value over the common span of fit_modes (NaN where they share none), and the grid, objective."""
+        lo, hi = span(fit_modes)
+        if lo > hi:
+            return math.nan, np.array([]), np.array([])
+        grid = np.linspace(lo, hi, n_fine)
         total = np.zeros_like(grid)
         for m in fit_modes:
             for q in _targets_for(m, balance):
                 meas = float(exp.loc[m, f"bead_{q}_mm"])
                 total += ((pred(m, q, grid) - meas) / meas) ** 2
-        return total
+        if not np.isfinite(total).any():
+            return math.nan, grid, total
+        return float(grid[np.nanargmin(total)]), grid, total
 
-    obj_all = objective(modes)
-    best_all = float(grid[np.argmin(obj_all)])
+    best_all, grid_all, obj_all = fit(modes)
+    lo, hi = span(modes)
     # Where the objective is flat the fit is not identifiable: report the whole near-optimal interval.
-    near = grid[obj_all <= obj_all.min() * 1.01 + 1e-9]
+    near = grid_all[obj_all <= np.nanmin(obj_all) * 1.01 + 1e-9] if np.isfinite(best_all) else np.array([np.nan])
     rows = []
     for m in modes:
         others = [o for o in modes if o != m]
-        best = float(grid[np.argmin(objective(others))])
+        best = fit(others)[0]
+        # the left-out mode is predicted only inside its own swept range (NaN outside: no extrapolation)
         row = {"mode": m, "fit_on_modes": " ".join(map(str, others)), f"{parameter}_loo": best,
                f"{parameter}_all": best_all, "measured_mass_consistent": bool(balance.loc[m, "consistent"])}
         for q in ("width", "height"):
             meas = float(exp.loc[m, f"bead_{q}_mm"])
-            p_loo = float(pred(m, q, best))
-            p_all = float(pred(m, q, best_all))
+            p_loo = float(pred(m, q, np.array([best]))[0]) if np.isfinite(best) else math.nan
+            p_all = float(pred(m, q, np.array([best_all]))[0]) if np.isfinite(best_all) else math.nan
             row.update({f"{q}_meas_mm": meas, f"{q}_pred_loo_mm": p_loo, f"{q}_err_rel_loo": (p_loo - meas) / meas,
                         f"{q}_pred_fit_mm": p_all, f"{q}_err_rel_fit": (p_all - meas) / meas})
         rows.append(row)
@@ -101,12 +115,14 @@ def loo_calibration(ds: xr.Dataset, exp: pd.DataFrame, parameter: str = "beam_ef
         "parameter": parameter,
         "width_metric": width_metric,
         "range_searched": [float(lo), float(hi)],
+        "ranges_per_mode": {int(m): [float(c[parameter].min()), float(c[parameter].max())] for m, c in curves.items()},
         f"{parameter}_all": best_all,
-        f"{parameter}_all_interval": [float(near.min()), float(near.max())],
-        "identifiable": bool(near.max() - near.min() < 0.05 * (hi - lo)),
-        "width_rms_err_rel_loo": float(np.sqrt(np.mean(table["width_err_rel_loo"] ** 2))),
-        "height_rms_err_rel_loo": float(np.sqrt(np.mean(table["height_err_rel_loo"] ** 2))),
-        "height_rms_err_rel_loo_consistent_modes": float(np.sqrt(np.mean(
+        f"{parameter}_all_interval": [float(np.nanmin(near)), float(np.nanmax(near))],
+        "identifiable": bool(hi > lo and np.nanmax(near) - np.nanmin(near) < 0.05 * (hi - lo)),
+        "modes_predicted_loo": int(table["width_err_rel_loo"].notna().sum()),
+        "width_rms_err_rel_loo": float(np.sqrt(np.nanmean(table["width_err_rel_loo"] ** 2))),
+        "height_rms_err_rel_loo": float(np.sqrt(np.nanmean(table["height_err_rel_loo"] ** 2))),
+        "height_rms_err_rel_loo_consistent_modes": float(np.sqrt(np.nanmean(
             table.loc[table["measured_mass_consistent"], "height_err_rel_loo"] ** 2)))
         if table["measured_mass_consistent"].any() else math.nan,
     }
