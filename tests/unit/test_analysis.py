@@ -27,15 +27,22 @@ def test_richardson_flags_oscillation():
     assert not richardson(np.array([0.2, 0.3, 0.4]), np.array([1.0, 1.1, 1.05]))["monotone"]
 
 
-def test_leave_one_out_never_fits_a_mode_to_itself(tmp_path, experiments):
+@pytest.fixture(scope="module")
+def calibration_runs(tmp_path_factory, experiments):
+    """Dataset of real reduced runs: the three measured modes at beam efficiency 0.3, 0.6 and 0.9."""
+    out = tmp_path_factory.mktemp("cal")
     cfg = {"study": "cal", "sweep": [{"cases": [{"experiment": m} for m in (1, 2, 3)],
                                       "grid": {"beam_efficiency": [0.3, 0.6, 0.9]}}]}
     table = design(cfg, experiments)
     results = []
     for run_id in table.index:
-        run_case(case_params(table, run_id), tmp_path / run_id, run_id=run_id)
-        results.append(tmp_path / run_id / "result.json")
-    ds = build_dataset(results, None, cfg, table)
+        run_case(case_params(table, run_id), out / run_id, run_id=run_id)
+        results.append(out / run_id / "result.json")
+    return build_dataset(results, None, cfg, table)
+
+
+def test_leave_one_out_never_fits_a_mode_to_itself(calibration_runs, experiments):
+    ds = calibration_runs
     loo, summary = loo_calibration(ds, experiments, "beam_efficiency")
     assert list(loo["mode"]) == [1, 2, 3]
     for _, row in loo.iterrows():
@@ -56,18 +63,11 @@ def test_leave_one_out_never_fits_a_mode_to_itself(tmp_path, experiments):
             row["beam_efficiency_loo"], ds["beam_efficiency"].values[mine], ds["pool_width_mm"].values[mine]))
 
 
-def test_leave_one_out_searches_each_fit_over_its_own_modes(tmp_path, experiments):
+def test_leave_one_out_searches_each_fit_over_its_own_modes(calibration_runs, experiments):
     """Mode 3 has an ok run at one value only (its others failed, as SPH runs that stub): the fits that use mode 3
     are pinned to that value, the fit that leaves it out searches the whole range, and mode 3 is not predicted
     outside the one value it was run at."""
-    cfg = {"study": "cal", "sweep": [{"cases": [{"experiment": m} for m in (1, 2, 3)],
-                                      "grid": {"beam_efficiency": [0.3, 0.6, 0.9]}}]}
-    table = design(cfg, experiments)
-    results = []
-    for run_id in table.index:
-        run_case(case_params(table, run_id), tmp_path / run_id, run_id=run_id)
-        results.append(tmp_path / run_id / "result.json")
-    ds = build_dataset(results, None, cfg, table)
+    ds = calibration_runs
     mode = match_experiments(ds, experiments)
     keep = [i for i, c in enumerate(ds["case"].values)
             if mode[str(c)] != 3 or ds["beam_efficiency"].values[i] == 0.9]

@@ -49,8 +49,7 @@ def loo_calibration(ds: xr.Dataset, exp: pd.DataFrame, parameter: str = "beam_ef
     interpolated between the swept values. So no mode is predicted by a fit to itself. Each fit searches the range
     swept (with ok runs) by every mode it fits, and the left-out mode is predicted only inside its own range (NaN
     outside it, no extrapolation), so one mode whose runs failed at some values does not narrow the others' fits.
-    The predicted width is
-    ``width_metric``: ``bead_width_mm`` (the bead's height profile), or ``fusion_width_mm`` (the molten top
+    The predicted width is ``width_metric``: ``bead_width_mm`` (the bead's height profile), or ``fusion_width_mm`` (the molten top
     surface) where the bead is too flat for a height threshold (SPH beads one or two particles high).
 
     Returns

@@ -537,21 +537,20 @@ class BeadRun:
                       f"{h:.9g}"]
         styles.append("sph/heatconduction")
         coeffs.append(f"pair_coeff * * sph/heatconduction {self.mat.diffusivity:.9g} {h:.9g}")
+        not_liquid = (TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED, TYPE_FALLING)
         f = self.p["melt_conductivity_factor"]
         if f != 1:  # Marangoni stand-in: liquid-liquid pairs (symmetric), optionally liquid-solid at the harmonic mean
             coeffs.append(f"pair_coeff {TYPE_LIQUID} {TYPE_LIQUID} sph/heatconduction "
                           f"{self.mat.diffusivity * f:.9g} {h:.9g}")
             if self.p["melt_interface_conductivity"] == "harmonic":
                 d_int = self.mat.diffusivity * 2 * f / (1 + f)
-                for other in (TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED, TYPE_FALLING):
+                for other in not_liquid:
                     i, j = sorted((TYPE_LIQUID, other))
                     coeffs.append(f"pair_coeff {i} {j} sph/heatconduction {d_int:.9g} {h:.9g}")
         model = self.num.cohesion
         if model is not None:  # surface tension: one more overlay sub-style, liquid-liquid and liquid-solid
             styles.append(model.pair_style_tokens())
-            coeffs += model.pair_coeff_commands([TYPE_LIQUID],
-                                                [TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED, TYPE_FALLING],
-                                                table_file=self.out / "tension.table")
+            coeffs += model.pair_coeff_commands([TYPE_LIQUID], list(not_liquid), table_file=self.out / "tension.table")
         return styles, coeffs
 
     def _define_physics(self) -> None:
@@ -690,7 +689,6 @@ class BeadRun:
         if not g.moving_window:
             return False
         created = False
-        m = self.num.mass
         vel = g.substrate_velocity
         e0 = self.thermal.energy(self.T0)
         n_before = int(self.lmp.get_natoms())
@@ -722,15 +720,14 @@ class BeadRun:
             created = True
         if not created:
             return False
-        x, v, e, types = self._x(), self._v(), self._e(), self._types()
+        x, types = self._x(), self._types()
         out = x[:, 0] < g.x_lo
         n_liquid = allreduce(self.lmp, int((out & (types == TYPE_LIQUID)).sum()))
         if n_liquid:
             raise SimulationFailed(f"{n_liquid} molten particles reached the rear face of the moving window at "
                                    f"t={st.t:.4g} s: the pool is longer than the window (raise window_bead_mm)",
                                    self._metrics(partial=True))
-        energy = float(e[out].sum() + 0.5 * m * np.einsum("ij,ij->", v[out], v[out]) + m * GRAVITY * x[out, 2].sum())
-        st.ledger.advected_out += allreduce(self.lmp, energy)
+        st.ledger.advected_out += allreduce(self.lmp, self._energy_of(out))
         if allreduce(self.lmp, int(out.sum())):
             self.deck("delete_atoms region behind compress no")
         return True
@@ -741,7 +738,7 @@ class BeadRun:
         box and be lost. Their energy goes into the ledger and their number into ``spatter_particles``; the
         watchdog fails the run beyond ``spatter_limit``. True if atoms were deleted."""
         g, d = self.geom, self.geom.dx
-        x, v, e, types = self._x(), self._v(), self._e(), self._types()
+        x, types = self._x(), self._types()
         out = np.isin(types, FLUID_TYPES) & (
             (x[:, 0] > g.x_hi + 2 * d) | (x[:, 0] < g.x_lo - 2 * d) | (np.abs(x[:, 1]) > g.y_hi + 2 * d)
             | (x[:, 2] < g.z_lo - 2 * d) | (x[:, 2] > g.box_z_hi - d / 2))
@@ -750,9 +747,7 @@ class BeadRun:
         gone = allgather_rows(self.lmp, self._ids()[out])
         if len(gone) == 0:
             return False
-        m = self.num.mass
-        energy = float(e[out].sum() + 0.5 * m * np.einsum("ij,ij->", v[out], v[out]) + m * GRAVITY * x[out, 2].sum())
-        self.state.ledger.ejected += allreduce(self.lmp, energy)
+        self.state.ledger.ejected += allreduce(self.lmp, self._energy_of(out))
         self.state.n_ejected += len(gone)
         if self.rank0:
             log.info("t %.4f s: %d fluid particles left the block (spatter), deleted: %d so far", self.state.t,
@@ -761,6 +756,11 @@ class BeadRun:
         self.deck("delete_atoms group spatter compress no")
         self.deck("group spatter delete")
         return True
+
+    def _energy_of(self, mask: np.ndarray) -> float:
+        """Internal + kinetic + potential energy (J) of this rank's particles in mask (not reduced)."""
+        x, v, e, m = self._x(), self._v(), self._e(), self.num.mass
+        return float(e[mask].sum() + 0.5 * m * np.einsum("ij,ij->", v[mask], v[mask]) + m * GRAVITY * x[mask, 2].sum())
 
     def _phase_update(self) -> tuple[np.ndarray, bool]:
         """Temperatures, types, frozen velocities and densities after a chunk.

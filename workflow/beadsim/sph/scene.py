@@ -84,13 +84,13 @@ class SceneGeometry:
     @property
     def wire_velocity(self) -> np.ndarray:
         """Velocity of unmelted wire, m/s: feed towards the tip, plus travel in the substrate frame."""
-        return np.array([self.substrate_speed, 0.0, 0.0]) + self.substrate_velocity \
-            - self.wire_feed * self.wire_axis
+        return self.wire_velocity_at(True)
 
     def wire_velocity_at(self, feeding: bool) -> np.ndarray:
         """Velocity of unmelted wire (m/s) while it is fed, or held still relative to the beam before the feed
         starts (``wire_feed_start = pool``)."""
-        return self.wire_velocity if feeding else np.array([self.substrate_speed, 0.0, 0.0]) + self.substrate_velocity
+        travel = np.array([self.substrate_speed, 0.0, 0.0]) + self.substrate_velocity
+        return travel - self.wire_feed * self.wire_axis if feeding else travel
 
     def wire_landing_x(self) -> float:
         """Offset (m) along x from the beam axis of the point where the lowest edge of the wire's tip face meets
