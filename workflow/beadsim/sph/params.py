@@ -25,6 +25,11 @@ SPH_PARAMETERS: list[Param] = [
           "artificial)", minimum=0, maximum=10, short="av", models=_SPH, long_name="artificial viscosity"),
     Param("kernel_cutoff_factor", "number", 2.5, "1", "kernel cutoff h as a multiple of the particle spacing "
           "(Lucy kernel)", minimum=1.2, maximum=5, short="hdx", models=_SPH, long_name="kernel cutoff / dx"),
+    Param("fluid_pairs_only", "boolean", True, "", "compute the SPH pressure and viscosity pair term only for "
+          "pairs with a liquid or falling particle; pairs of frozen particles (which move rigidly, have their "
+          "forces zeroed and their densities reset) get heat conduction only. A speed lever: false computes the "
+          "term for every pair (the cost before 2026-11-22; same answer)", short="fpo", models=_SPH,
+          long_name="fluid pairs only"),
     Param("surface_tension", "boolean", False, "", "add a pairwise cohesive (surface tension) force between "
           "liquid particles (beadsim.sph.tension); off in the paper", short="st", models=_SPH),
     Param("latent_heat", "boolean", False, "", "latent heat of fusion as an effective heat capacity over "

@@ -1,0 +1,45 @@
+"""Speed levers change the cost, not the answer.
+
+``fluid_pairs_only`` drops the SPH pressure/viscosity term from pairs of frozen particles. Such pairs move
+rigidly (equal velocities: their density and energy increments are exactly zero) and their forces are zeroed, so
+the answer changes only through pairs of frozen particles with different velocities (the fed wire against the
+substrate) and through particles that melt within a chunk (they feel the melt before their type switches). The
+trajectories then separate as those of 1 and 2 MPI ranks do (test_mpi), so the same tolerances apply.
+"""
+
+import pytest
+import xarray as xr
+
+from beadsim.sph.driver import fluid_pair_types, run_case
+from beadsim.sph.scene import FLUID_TYPES, N_TYPES
+
+from test_bead import small_case
+
+
+def test_fluid_pair_types_cover_every_pair_with_melt():
+    pairs = {(int(i), int(j)) for i, j in fluid_pair_types(True)}
+    for i in range(1, N_TYPES + 1):
+        for j in range(i, N_TYPES + 1):
+            assert ((i, j) in pairs) == (i in FLUID_TYPES or j in FLUID_TYPES), (i, j)
+    assert fluid_pair_types(False) == [("*", "*")]
+
+
+@pytest.mark.slow
+def test_fluid_pairs_only_keeps_the_answer(tmp_path):
+    runs = {}
+    for on in (True, False):
+        out = tmp_path / f"fpo_{on}"
+        runs[on] = run_case(small_case(sim_time_s=0.25, fluid_pairs_only=on), out)
+        deck = (out / "deck.in").read_text()
+        assert ("pair_coeff * * sph/taitwater" in deck) is not on
+        assert ("pair_coeff 3 3 sph/taitwater" in deck) is on
+    on, off = runs[True], runs[False]
+    assert on["n_steps"] == off["n_steps"] and on["n_particles"] == off["n_particles"]
+    assert on["energy_in_J"] == pytest.approx(off["energy_in_J"], rel=1e-12)
+    assert abs(on["energy_balance_error"]) < 1e-3
+    for key in ("evaporated_energy_J", "boundary_heat_loss_J"):
+        assert on[key] == pytest.approx(off[key], rel=0.10), key
+    series = [xr.load_dataset(tmp_path / f"fpo_{flag}" / "timeseries.nc") for flag in (True, False)]
+    late = [s["n_liquid"].where(s["t"] > 0.125).mean().item() for s in series]
+    assert late[0] == pytest.approx(late[1], rel=0.10)
+    assert series[0]["E_internal"][-1].item() == pytest.approx(series[1]["E_internal"][-1].item(), rel=0.01)
