@@ -4,6 +4,8 @@ Prints, from one run on this machine:
 
 1. throughput: particle-steps per second of a short moving-window run of mode 1 on 1 and 2 MPI ranks (median of
    ``--repeats``), and the share of wall time spent outside LAMMPS (Python between chunks, 1 rank);
+1b. the ``fluid_pairs_only`` lever on and off on a scene with melt (mode 2 at ``--dx`` for ``--lever-time``):
+   particle-steps per second of each, their ratio and what the lever changes in the pool;
 2. each Table 4 mode with every speed lever on (moving window, steady-state stop, 2 ranks) at ``--dx``: wall time,
    particles, steps, steady-state time, bead width and height and their error against Table 1;
 3. the paper's whole plate for its full 2 s at ``--dx``: measured per-particle-step cost of a short whole-plate
@@ -40,8 +42,10 @@ log = logging.getLogger("beadsim.bench")
 LEVERS = {"domain": "window", "stop_at_steady_state": True}
 
 
-#: The production physics of the table4_sph study (the same in every bench run, so that comparisons are fair).
-PHYSICS = {"melt_conductivity_factor": 5.0}
+#: The production physics and scene settings of the table4_sph study (the same in every bench run, so that
+#: comparisons are fair): melt conductivity x5, window margin 4 thermal lengths (mode 2 melts past the side faces
+#: at 3), wire feed started on the pool (mode 3 stubs when fed from t = 0).
+PHYSICS = {"melt_conductivity_factor": 5.0, "window_thermal_lengths": 4.0, "wire_feed_start": "pool"}
 
 
 def mode_params(mode: int, **overrides) -> dict:
@@ -89,9 +93,11 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--ranks", type=int, default=2, help="MPI ranks per run with the levers (default 2)")
     ap.add_argument("--repeats", type=int, default=3, help="repeats of the throughput runs (default 3)")
     ap.add_argument("--throughput-time", type=float, default=0.02, help="process time of a throughput run, s")
+    ap.add_argument("--lever-time", type=float, default=0.2,
+                    help="process time of the fluid-pairs lever runs (mode 2 at --dx, with melt), s")
     ap.add_argument("--ref-dx", type=float, default=0.4, help="resolution of the whole-plate comparison, mm")
     ap.add_argument("--full-plate", action="store_true", help="run the whole plate at --dx for 2 s (hours)")
-    ap.add_argument("--skip", nargs="*", default=[], choices=["throughput", "modes", "plate", "reference"])
+    ap.add_argument("--skip", nargs="*", default=[], choices=["throughput", "levers", "modes", "plate", "reference"])
     ap.add_argument("--fresh", action="store_true", help="repeat runs that already have results")
     ap.add_argument("--out", type=Path, default=Path("results/bench"))
     args = ap.parse_args(argv)
@@ -123,6 +129,34 @@ def main(argv: list[str] | None = None) -> dict:
         if len(tp) > 1:
             print(f"    speed-up {args.ranks} ranks / 1 rank: "
                   f"{tp[args.ranks]['particle_steps_per_s'] / tp[1]['particle_steps_per_s']:.2f}")
+
+    # 1b. the fluid-pairs lever, on a scene with melt (the throughput runs above end before the pool forms)
+    if "levers" not in args.skip:
+        print(f"[1b] lever fluid_pairs_only: mode 2, moving window, dx {args.dx} mm, {args.lever_time} s of process "
+              f"(the pool is forming), {args.ranks} ranks, lever on and off", flush=True)
+        lev = {}
+        for on in (True, False):
+            rec = run(mode_params(2, domain="window", resolution_mm=args.dx, sim_time_s=args.lever_time,
+                                  fluid_pairs_only=on, restart_interval_s=60.0, dump_interval_s=60.0),
+                      out / f"lever_fpo_{'on' if on else 'off'}_dx{args.dx}", args.ranks, args.fresh)
+            m = rec["metrics"]
+            lev["on" if on else "off"] = {
+                "status": rec["status"], "reason": rec["reason"], "wall_s": rec["elapsed_s"],
+                "particle_steps_per_s": m.get("particle_steps_per_s"), "n_particles": m.get("n_particles"),
+                "n_steps": m.get("n_steps"), "simulated_time_s": m.get("simulated_time_s"),
+                "python_time_share": m.get("python_time_share"), "pool_volume_mm3": m.get("pool_volume_mm3"),
+                "boundary_heat_loss_J": m.get("boundary_heat_loss_J")}
+        report["levers"] = lev
+        for key, v in lev.items():
+            print(f"    fluid pairs only {key:>3}: {v['status']} {v['reason']}; "
+                  f"{(v['particle_steps_per_s'] or math.nan) / 1e6:.3f} M particle-steps/s, {v['n_particles']} "
+                  f"particles x {v['n_steps']} steps to t = {v['simulated_time_s']:.3g} s, time outside LAMMPS "
+                  f"{(v['python_time_share'] or math.nan):.1%}, pool {(v['pool_volume_mm3'] or math.nan):.3g} mm3",
+                  flush=True)
+        if all(v["particle_steps_per_s"] for v in lev.values()):
+            print(f"    speed-up on / off: {lev['on']['particle_steps_per_s'] / lev['off']['particle_steps_per_s']:.2f}; "
+                  f"pool volume {rel(lev['on']['pool_volume_mm3'], lev['off']['pool_volume_mm3']):+.1%}, boundary "
+                  f"heat loss {rel(lev['on']['boundary_heat_loss_J'], lev['off']['boundary_heat_loss_J']):+.1%}")
 
     # 2. every mode with all levers
     if "modes" not in args.skip:
