@@ -88,6 +88,12 @@ def test_watchdog_catches_large_time_step(tmp_path):
     assert "t=" in reason and any(word in reason for word in ("density", "speed", "lost", "non-finite", "energy"))
     assert info.value.metrics["simulated_time_s"] < params["sim_time_s"]
     assert (tmp_path / "deck.in").exists()
+    if "density" in reason:  # the reason says where the worst particle sits
+        assert "worst:" in reason and "particles within the kernel radius" in reason
+    # the state at the trip is dumped for inspection, complete (every particle)
+    failed = (tmp_path / "dumps" / "failed.lammpstrj").read_text().splitlines()
+    n_atoms = int(failed[failed.index("ITEM: NUMBER OF ATOMS") + 1])
+    assert n_atoms > 0 and len(failed) == failed.index(next(l for l in failed if l.startswith("ITEM: ATOMS"))) + 1 + n_atoms
 
 
 def test_beam_lands_on_the_surface_seen_from_above():

@@ -185,6 +185,19 @@ def test_fusion_width_is_the_molten_top_seen_from_above():
     melted = (np.abs(pos[:, 1]) < 1.5e-3) & (pos[:, 2] > -3 * DX)  # 3 mm wide molten top, 3 layers deep
     assert fusion_width(pos, melted, DX, WINDOW) == pytest.approx(3.0, abs=1e-9)
     assert fusion_width(pos, np.zeros(len(pos), bool), DX, WINDOW) == 0.0
-    # a stray unmolten particle on top of one column does not cut the fused run (medians over x columns)
+    # a stray unmolten particle on top of one column does not cut the fused run: it takes that column's share
     stray = np.array([[0.5 * DX, 0.05e-3, 1.5 * DX]])
-    assert fusion_width(np.vstack([pos, stray]), np.append(melted, False), DX, WINDOW) == pytest.approx(3.0)
+    columns = round((WINDOW[1] - WINDOW[0]) / DX)
+    assert fusion_width(np.vstack([pos, stray]), np.append(melted, False), DX, WINDOW) == pytest.approx(
+        3.0 - DX * 1e3 / columns, abs=1e-9)
+
+
+def test_fusion_width_between_lattice_steps():
+    """A molten edge that steps out by one spacing halfway along the window (a pool whose width fluctuated as
+    the lattice moved through it): the fused width is the mean, 3.1 mm, not a whole number of spacings."""
+    from beadsim.sph.surface import fusion_width
+
+    pos = lattice((0.0, -3e-3, -1e-3), (2e-3, 3e-3, 0.0))
+    half = np.where(pos[:, 0] < 1e-3, 1.5e-3, 1.6e-3)
+    melted = (np.abs(pos[:, 1]) < half) & (pos[:, 2] > -3 * DX)
+    assert fusion_width(pos, melted, DX, WINDOW) == pytest.approx(3.1, abs=1e-9)

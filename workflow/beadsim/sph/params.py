@@ -28,7 +28,7 @@ SPH_PARAMETERS: list[Param] = [
     Param("fluid_pairs_only", "boolean", True, "", "compute the SPH pressure and viscosity pair term only for "
           "pairs with a liquid or falling particle; pairs of frozen particles (which move rigidly, have their "
           "forces zeroed and their densities reset) get heat conduction only. A speed lever: false computes the "
-          "term for every pair (the cost before 2026-11-22; same answer)", short="fpo", models=_SPH,
+          "term for every pair (the cost before 2026-11-22; the same answer within run-to-run scatter)", short="fpo", models=_SPH,
           long_name="fluid pairs only"),
     Param("surface_tension", "boolean", False, "", "add a pairwise cohesive (surface tension) force between "
           "liquid particles (beadsim.sph.tension); off in the paper", short="st", models=_SPH),

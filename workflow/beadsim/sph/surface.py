@@ -303,14 +303,19 @@ def penetration_depth(pos, melted_mask, dx, x_window, z_surface=0.0):
 
 
 def fusion_width(pos, melted_mask, dx, x_window, z_surface=0.0):
-    """Width of the fused track seen from above (mm): the lateral extent of the top surface that was ever liquid.
+    """Width of the fused track seen from above (mm): the area of the top surface that was ever liquid, per
+    unit length of the window.
 
-    Method: two :func:`height_map` profiles over the window, of all material and of the ever-melted material
-    only; a y bin is fused where the melted top lies within ``dx/2`` of the top (the particle on top of the
-    median column has been liquid). The width is the number of bins in the contiguous fused run that contains
-    the highest bin, times ``dx``. Unlike the height threshold of :func:`bead_cross_section` it does not need
-    the bead to stand a particle layer above the surface, so it stays defined for a flat bead a layer or two
-    thick; it is also wider than the bead where the pool melted the substrate beside it.
+    Method: per (x, y) column of width ``dx`` in the window, the column is fused where its top particle has been
+    liquid (the highest ever-melted particle lies within ``dx/2`` of the column's top). Per y bin, f = the
+    fraction of the window's x columns that are fused. The width is ``dx`` times the sum of f over the
+    contiguous run of bins with f > 0 that contains the fused bin with the highest median top. A straight fused
+    edge along the lattice gives whole bins (the width is n dx); an edge that wavers along x (the pool's width
+    fluctuates as the lattice moves through it) gives the fused area's mean width, between the lattice steps.
+    A stray unmolten particle on a fused column changes the width by one column's share, dx / (columns in the
+    window). Unlike the height threshold of :func:`bead_cross_section` it does not need the bead to stand a
+    particle layer above the surface, so it stays defined for a flat bead a layer or two thick; it is also wider
+    than the bead where the pool melted the substrate beside it.
 
     Parameters
     ----------
@@ -320,15 +325,26 @@ def fusion_width(pos, melted_mask, dx, x_window, z_surface=0.0):
     Returns
     -------
     float
-        Width in mm (0 if no bin is fused).
+        Width in mm (0 if no column is fused).
     """
     pos = np.asarray(pos, dtype=float).reshape(-1, 3)
-    _, top = height_map(pos, dx, x_window, z_surface)
-    _, top_melt = height_map(pos, dx, x_window, z_surface, mask=np.asarray(melted_mask, dtype=bool))
-    if len(top) == 0:
+    melted = np.asarray(melted_mask, dtype=bool)
+    inside = _window(pos, x_window)
+    if not inside.any():
         return 0.0
-    fused = np.isfinite(top) & np.isfinite(top_melt) & (np.nan_to_num(top_melt, nan=-np.inf) >= top - 0.5 * dx)
-    if not fused.any():
+    grid, molten = pos[inside], melted[inside]
+    ix = bin_index(grid[:, 0], dx, lattice_phase(grid[:, 0], dx))
+    iy = bin_index(grid[:, 1], dx, lattice_phase(grid[:, 1], dx))
+    ix, iy = ix - ix.min(), iy - iy.min()
+    shape = (ix.max() + 1, iy.max() + 1)
+    top, top_melt = np.full(shape, -np.inf), np.full(shape, -np.inf)
+    np.maximum.at(top, (ix, iy), grid[:, 2])
+    np.maximum.at(top_melt, (ix[molten], iy[molten]), grid[molten, 2])
+    exists = np.isfinite(top)
+    fused = exists & (top_melt >= top - 0.5 * dx)
+    frac = fused.sum(axis=0) / np.maximum(exists.sum(axis=0), 1)
+    if not (frac > 0).any():
         return 0.0
-    run = _bead_run(np.where(fused, top, np.nan), -np.inf)  # fused bins have a finite top
-    return (run.stop - run.start) * dx * 1e3
+    _, median_top = height_map(pos, dx, x_window, z_surface)
+    run = _bead_run(np.where(frac > 0, np.nan_to_num(median_top, nan=-1.0), np.nan), -np.inf)
+    return float(frac[run].sum()) * dx * 1e3
