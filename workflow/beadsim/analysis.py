@@ -167,7 +167,8 @@ def richardson(h: np.ndarray, f: np.ndarray, safety: float = 1.25) -> dict:
     return {"order": p, "extrapolated": extrap, "gci_fine": gci, "monotone": bool(s > 0)}
 
 
-CONVERGENCE_METRICS = ("bead_width_mm", "bead_height_mm", "pool_length_mm", "pool_width_mm", "pool_depth_mm")
+CONVERGENCE_METRICS = ("bead_width_mm", "fusion_width_mm", "bead_height_mm", "pool_length_mm", "pool_width_mm",
+                       "pool_depth_mm")
 
 
 def convergence_table(ds: xr.Dataset, parameter: str = "resolution_mm",

@@ -1308,7 +1308,7 @@ class BeadRun:
                 # steady state: the mean of the last three cross-sections (0.05 s apart)
                 from beadsim.sph import surface
 
-                for key in ("mass_balance_ratio", "penetration_depth_mm"):
+                for key in ("mass_balance_ratio", "penetration_depth_mm", "fusion_width_mm"):
                     out[key] = float(np.nanmean([c.get(key, np.nan) for c in checks]))
                 out.update(self._pool_means())
                 y = self.profiles[-1][0]
