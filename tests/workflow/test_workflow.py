@@ -1,5 +1,6 @@
 """Real snakemake on a tiny study in a temporary directory: dataset, maps, comparison, report, re-runs, errors."""
 
+import re
 import shutil
 import subprocess
 import sys
@@ -115,7 +116,8 @@ def test_sph_blow_up_is_recorded_and_the_study_completes(tmp_path):
     out = tmp_path / "results" / "tiny_sph"
     ds = xr.load_dataset(out / "dataset.nc")
     assert dict(zip(ds["case"].values, ds["status"].values)) == {"dtf1": "ok", "dtf8": "failed"}
-    assert "density" in str(ds["reason"].sel(case="dtf8").values)
+    # the watchdog's own reason: dt 8x the limit shows first as a density excursion or as lost particles
+    assert re.search(r"(density|particles lost).* at t=", str(ds["reason"].sel(case="dtf8").values))
     assert ds.attrs["lammps_versions"] == "20250722"
     classes = (out / "stability" / "classes.csv").read_text()
     assert "blown_up" in classes and ("stable" in classes or "degraded" in classes)
