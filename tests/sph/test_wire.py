@@ -84,3 +84,28 @@ def test_spatter_leaving_the_block_is_deleted_with_its_energy_in_the_ledger(tmp_
     m = run._measure(run.thermal.temperature(run._e()))
     with pytest.raises(SimulationFailed, match="spatter"):
         run._watchdog(m, int(run.lmp.get_natoms()))
+
+
+def test_a_droplet_at_the_rear_face_is_spatter_and_the_pool_there_fails_the_run(tmp_path):
+    """Moving window: melt reaching the rear face fails the run only when it belongs to the pool (the window is
+    too short); a molten particle apart from the pool (a droplet resting on the solid bead) leaves as spatter."""
+    from beadsim.sph.driver import BeadRun
+
+    run = BeadRun(mode3(spatter_limit=0), tmp_path)
+    run.open(resume=False)
+    g, d = run.geom, run.geom.dx
+    x = run._x()
+    blob = (x[:, 0] < g.x_lo + 3 * d) & (np.abs(x[:, 1]) < 1.5e-3) & (x[:, 2] > -1.5e-3)
+    drop = np.flatnonzero((x[:, 0] < g.x_lo + d) & (x[:, 1] > 4e-3) & (x[:, 2] > -d))[:1]
+    run.deck("group blob id " + " ".join(str(int(i)) for i in run._ids()[blob]))
+    run.deck("set group blob type 3")
+    drop_id = int(run._ids()[drop[0]])
+    run.deck(f"set atom {drop_id} type 3")
+    run.deck("run 0 post no")
+    x, types = run._x(), run._types()
+    rear, only_drop = x[:, 0] < g.x_lo + d, run._ids() == drop_id
+    assert only_drop.sum() == 1 and types[only_drop][0] == 3
+    run._rear_face_melt(x, types, only_drop)
+    assert run.state.n_ejected == 1
+    with pytest.raises(SimulationFailed, match="of the pool reached the rear face"):
+        run._rear_face_melt(x, types, rear)
