@@ -109,3 +109,17 @@ def test_a_droplet_at_the_rear_face_is_spatter_and_the_pool_there_fails_the_run(
     assert run.state.n_ejected == 1
     with pytest.raises(SimulationFailed, match="of the pool reached the rear face"):
         run._rear_face_melt(x, types, rear)
+
+
+def test_cut_off_wire_coheres_like_melt_with_surface_tension(tmp_path):
+    """With surface tension, falling wire gets the liquid-liquid cohesion with itself and the melt, and the
+    liquid-solid one with solid: under the lowered Tait reference density a piece without cohesion flies apart."""
+    from beadsim.sph.driver import BeadRun
+
+    run = BeadRun(mode3(surface_tension=True, artificial_viscosity=0.2), tmp_path)
+    run.open(resume=False)
+    table = {tuple(map(int, line.split()[1:3])): line.split()[5]
+             for line in (tmp_path / "deck.in").read_text().splitlines()
+             if line.startswith("pair_coeff") and " table " in line}
+    assert table == {(3, 3): "LL", (3, 5): "LL", (5, 5): "LL", (1, 3): "LS", (2, 3): "LS", (3, 4): "LS",
+                     (1, 5): "LS", (2, 5): "LS", (4, 5): "LS"}
