@@ -81,6 +81,12 @@ def test_spatter_leaving_the_block_is_deleted_with_its_energy_in_the_ledger(tmp_
     assert run.state.ledger.ejected > 0
     assert now - sum(run._energy_now().values()) == pytest.approx(run.state.ledger.ejected, rel=1e-9)
     assert not run._remove_spatter()  # nothing left outside
+    # behind the moving window's rear face too: a droplet falling off the plate there leaves the box before the
+    # rear face deletes it (which it does only when the next layer enters)
+    behind = int(run._ids()[1])
+    run.deck(f"set atom {behind} type 3 x {g.x_lo - 2 * g.dx:.9g} y 0 z {g.z_lo - 3 * g.dx:.9g} vz -0.3")
+    run.deck("run 0 post no")
+    assert run._remove_spatter() and run.state.n_ejected == 2
     m = run._measure(run.thermal.temperature(run._e()))
     with pytest.raises(SimulationFailed, match="spatter"):
         run._watchdog(m, int(run.lmp.get_natoms()))
