@@ -268,8 +268,9 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
 
 
 def calibration_plot(curves: dict, table: pd.DataFrame, exp: pd.DataFrame, parameter: str,
-                     attrs: dict) -> plt.Figure:
-    """Width and height against the calibrated parameter per mode, measured values, left-out fits."""
+                     attrs: dict, width_label: str = "bead width") -> plt.Figure:
+    """Width (``width_label`` names the metric compared) and height against the calibrated parameter per mode,
+    measured values, left-out fits."""
     fig, axes = plt.subplots(1, 2, figsize=(9, 4))
     xlabel = f"{attrs.get('long_name', parameter)} [{attrs.get('units', '')}]"
     loo = table.set_index("mode")
@@ -279,9 +280,9 @@ def calibration_plot(curves: dict, table: pd.DataFrame, exp: pd.DataFrame, param
             ax.axhline(float(exp.loc[mode, f"bead_{q}_mm"]), color=f"C{k}", ls="--", lw=1)
             x = loo.loc[mode, f"{parameter}_loo"]
             ax.plot([x], [loo.loc[mode, f"{q}_pred_loo_mm"]], "*", ms=12, color=f"C{k}")
-    for ax, q in zip(axes, ("width", "height")):
+    for ax, label in zip(axes, (width_label, "bead height")):
         ax.set_xlabel(xlabel)
-        ax.set_ylabel(f"bead {q} [mm]")
+        ax.set_ylabel(f"{label} [mm]", fontsize=8 if len(label) > 30 else None)
     axes[0].legend(title="dashed: measured; star: left-out fit", fontsize=7, title_fontsize=7)
     fig.tight_layout()
     return fig

@@ -16,5 +16,6 @@ table, summary = loo_calibration(ds, exp, parameter, width_metric=width)
 with atomic_path(snakemake.output.table) as tmp:
     table.to_csv(tmp, index=False)
 write_json(snakemake.output.summary, summary)
-save_figure(calibration_plot(response_curves(ds, exp, parameter, width), table, exp, parameter, ds[parameter].attrs),
-            snakemake.output.figure)
+label = ds[width].attrs.get("long_name", width)
+save_figure(calibration_plot(response_curves(ds, exp, parameter, width), table, exp, parameter, ds[parameter].attrs,
+                             width_label=label), snakemake.output.figure)
