@@ -53,6 +53,8 @@ def test_feed_started_on_the_pool_runs_and_the_wire_waits_for_it(tmp_path):
     if falling.any():
         gap = np.min(np.linalg.norm(atoms[falling, None, 2:5] - atoms[None, solid, 2:5], axis=2), axis=1)
         assert gap.min() > 0.9 * dx
+        # solid metal: its density is reset every chunk (it drifted to 0.73 rho0 at dx 0.2 before)
+        assert np.all(np.abs(atoms[falling, 8] / 7680.0 - 1) < 0.02)
     assert atoms[:, 4].min() > -3e-3 - dx  # nothing below the block (domain_depth_mm 3)
     # every particle still typed wire (and so fed) hangs on the feed end: cut-off pieces never stay wire
     g = build_geometry(mode3())

@@ -85,8 +85,8 @@ SPH_PARAMETERS: list[Param] = [
           "that share the beam energy of that column", minimum=1, maximum=10, short="bl", models=_SPH),
     Param("shepard_interval", "integer", 50, "1", "steps between Shepard density filters on the liquid "
           "(0 = never)", minimum=0, maximum=100000, short="shep", models=_SPH),
-    Param("solid_density_reset", "boolean", True, "", "reset the density of frozen particles to rho0 every "
-          "chunk", short="sdr", models=_SPH),
+    Param("solid_density_reset", "boolean", True, "", "reset the density of solid particles (frozen, and "
+          "falling cut-off wire) to rho0 every chunk", short="sdr", models=_SPH),
     Param("stop_at_steady_state", "boolean", False, "", "stop before sim_time_s once the melt count and pool "
           "length (and, in the window domain, the bead width and height) are steady within steady_tolerance",
           short="ss", models=_SPH),
