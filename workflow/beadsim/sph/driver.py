@@ -591,8 +591,8 @@ class BeadRun:
             # model a piece without cohesion of its own sits at a positive pressure and flies apart (measured:
             # 13 cut-off particles at 0.74 rho0 within 3 ms, mode 1, dx 0.4).
             styles.append(model.pair_style_tokens())
-            frozen = [t for t in not_liquid if t not in FLUID_TYPES]
-            coeffs += model.pair_coeff_commands(list(FLUID_TYPES), frozen, table_file=self.out / "tension.table")
+            solid_types = [t for t in not_liquid if t not in FLUID_TYPES]
+            coeffs += model.pair_coeff_commands(list(FLUID_TYPES), solid_types, table_file=self.out / "tension.table")
         return styles, coeffs
 
     def _define_physics(self) -> None:
@@ -801,7 +801,8 @@ class BeadRun:
                   | (x[:, 2] > g.box_z_hi - d / 2))
         # The moving window's rear face deletes what is behind it, but only when a layer enters at the front
         # (every dx / V_s): a droplet that ran off the plate's edge behind it fell out of the box before that
-        # (mode 2, efficiency 0.45, 2.45 s). So behind the face only the x test is left to the rear face.
+        # (mode 2, efficiency 0.45, 2.45 s). So the tests below and beside the block apply behind it too; only
+        # the test behind the rear face is left to the rear face.
         if not g.moving_window:
             beyond |= x[:, 0] < g.x_lo - 2 * d
         out = np.isin(types, FLUID_TYPES) & beyond
