@@ -5,6 +5,8 @@ quantities must agree exactly and the rest within a few percent (measured: evapo
 2.5 %, pool volume 3.6-10 % apart at 0.25 s).
 """
 
+import re
+
 import pytest
 import xarray as xr
 
@@ -34,6 +36,9 @@ def test_one_and_two_ranks_agree(tmp_path):
     assert late[1] == pytest.approx(late[0], rel=0.10)
     assert series[1]["E_internal"][-1].item() == pytest.approx(series[0]["E_internal"][-1].item(), rel=0.01)
     assert (tmp_path / "two" / "dumps").is_dir() and (tmp_path / "two" / "timeseries.nc").exists()
+    # rank 0's progress lines reach mpi.log (streamed while the ranks run), once each
+    times = re.findall(r" t ([0-9.]+) s, [0-9]+ steps/s", (tmp_path / "two" / "mpi.log").read_text())
+    assert len(times) >= 20 and len(set(times)) == len(times), times[:5]
 
 
 @pytest.mark.mpi

@@ -7,16 +7,21 @@ the runner in the parent process, turns back into metrics or a :class:`Simulatio
 
 from __future__ import annotations
 
+import collections
 import json
+import logging
 import shlex
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 from beadsim.errors import SimulationFailed
 from beadsim.io import write_json
 
 RESULT = "mpi_result.json"
+
+log = logging.getLogger("beadsim.sph.mpi")
 
 
 def run_mpi(params: dict, outdir: Path, tasks: int, mpi: str = "mpirun", materials_file=None,
@@ -40,12 +45,27 @@ def run_mpi(params: dict, outdir: Path, tasks: int, mpi: str = "mpirun", materia
 
         launcher[0] = mpirun()
     cmd = [*launcher, "-n", str(tasks), sys.executable, "-m", "beadsim.sph.mpi_main", str(outdir)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    (outdir / "mpi.log").write_text(proc.stdout + proc.stderr)
+    # The ranks' output (rank 0's progress lines) goes to mpi.log and to this process's log as it comes, so a
+    # multi-rank run shows its progress while it runs.
+    tail: collections.deque = collections.deque(maxlen=3)
+    with open(outdir / "mpi.log", "w", buffering=1) as fh:
+        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1)
+        timer = threading.Timer(timeout, proc.kill) if timeout else None
+        if timer:
+            timer.start()
+        try:
+            for line in proc.stdout:
+                fh.write(line)
+                if line.strip():
+                    tail.append(line.strip())
+                    log.info("ranks: %s", line.rstrip())
+            code = proc.wait()
+        finally:
+            if timer:
+                timer.cancel()
     if not (outdir / RESULT).exists():
-        tail = " | ".join((proc.stdout + proc.stderr).strip().splitlines()[-3:])
-        raise SimulationFailed(f"MPI run ({' '.join(cmd[:3])} ...) exited with code {proc.returncode} and no "
-                               f"result: {tail}")
+        why = f"was killed after the timeout of {timeout} s" if timer and code < 0 else f"exited with code {code}"
+        raise SimulationFailed(f"MPI run ({' '.join(cmd[:3])} ...) {why} and no result: {' | '.join(tail)}")
     result = json.loads((outdir / RESULT).read_text())
     metrics = {k: (float("nan") if v is None else v) for k, v in result["metrics"].items()}
     metrics["mpi_ranks"] = result["ranks"]
@@ -68,6 +88,9 @@ def main(outdir: str) -> None:
     params = spec["params"]
     material = get_material(params["material"], spec["materials_file"] or None)
     comm = MPI.COMM_WORLD
+    # progress (INFO) from rank 0 only; the other ranks would repeat its lines
+    logging.basicConfig(level=logging.INFO if comm.rank == 0 else logging.ERROR, stream=sys.stderr,
+                        format="%(asctime)s %(name)s %(levelname)s %(message)s")
     status, reason, metrics = "ok", "", {}
     try:
         metrics = run_case(params, out, material=material, resume=spec["resume"])
