@@ -84,7 +84,7 @@ SPH_PARAMETERS: list[Param] = [
     Param("beam_layers", "integer", 2, "1", "particle layers below the top of each column seen from above "
           "that share the beam energy of that column", minimum=1, maximum=10, short="bl", models=_SPH),
     Param("shepard_interval", "integer", 50, "1", "steps between Shepard density filters on the liquid "
-          "(0 = never)", minimum=0, maximum=100000, short="shep", models=_SPH),
+          "(0 = never); not applied with surface_tension, where it lets the cohesive liquid expand", minimum=0, maximum=100000, short="shep", models=_SPH),
     Param("solid_density_reset", "boolean", True, "", "reset the density of solid particles (frozen, and "
           "falling cut-off wire) to rho0 every chunk", short="sdr", models=_SPH),
     Param("stop_at_steady_state", "boolean", False, "", "stop before sim_time_s once the melt count and pool "
