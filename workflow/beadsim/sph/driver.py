@@ -199,9 +199,9 @@ def is_rank0(lmp) -> bool:
 
 
 #: Kernel fill of the melt (:meth:`BeadRun._liquid_packing`) below which a run warns that its liquid expanded.
-#: Measured at dx 0.4 (mode 1, 90th percentile): 1.00 without surface tension; with it 0.81-0.97 (the melted
-#: wire is under-packed: its slices lie 1.27 dx apart to carry the nominal mass, see scene.wire_slice_pitch), and
-#: 0.63-0.75 with it and the Shepard filter (the expanded case).
+#: Measured at dx 0.4 (mode 1, 90th percentile): 1.00 without surface tension; with it 0.81-0.97 (the
+#: melted wire is under-packed: its slices lie 1.27 dx apart to carry the nominal mass, see
+#: scene.wire_slice_pitch), and 0.63-0.75 with it and the Shepard filter (the expanded case).
 LIQUID_PACKING_WARN = 0.85
 
 
@@ -1357,8 +1357,8 @@ class BeadRun:
                    if "liquid_packing" in m and m["t"] > st.t - 0.25 - 1e-9 and np.isfinite(m["liquid_packing"])]
         out["liquid_packing"] = float(np.mean(packing)) if packing else np.nan
         if out["liquid_packing"] < LIQUID_PACKING_WARN and self.rank0:
-            log.warning("the melt is under-packed: its kernel fill (90th percentile, last 0.25 s) is %.2f of the "
-                        "lattice's while its density variable stays near rho0 (it takes more volume than its mass)",
+            log.warning("the melt is under-packed: its kernel fill (90th percentile, last 0.25 s) is %.2f of "
+                        "the lattice's while its density variable stays near rho0 (more volume than its mass)",
                         out["liquid_packing"])
         if not partial:
             out.update(self._bead_metrics(out["wire_supply_area_mm2"]))
