@@ -7,8 +7,9 @@ particles seen from above inside the footprint, creates wire slices at the feed 
 between substrate / wire / liquid / resolidified, resets the velocities of frozen particles (to zero, or to the
 feed velocity for wire that never melted), resets the density of frozen particles, applies a Shepard filter to
 the liquid density (not with surface tension), raises the density of compressed particles in and around the
-melt to the kernel-sum density of their packing (:func:`compression_density`: the continuity density does not see melt collapsing onto the
-solid, whose density is reset, so without it the pool bottom packs up to 2x denser and the bead loses volume),
+melt to the kernel-sum density of their packing (:func:`compression_density`: the continuity density does not
+see melt collapsing onto the solid, whose density is reset, so without it the pool bottom packs up to 2x denser
+and the bead loses volume),
 caps temperatures at boiling (the excess counted as evaporation), removes heat through the
 cut faces of the block (far-field condition), closes the energy ledger and runs the watchdog.
 
