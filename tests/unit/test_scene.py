@@ -63,14 +63,15 @@ def test_beam_frame_velocities_and_inflow_layer():
 
 def _wire(g):
     """Initial wire particles and their axial distance from the tip plane (beam at x = 0)."""
-    pos, s_last = scene.initial_wire(g)
+    pos, s_last, _ = scene.initial_wire(g)
     s = (pos - np.array([0.0, 0.0, g.wire_height])) @ g.wire_axis
     return pos, s, s_last
 
 
+@pytest.mark.parametrize("packing", ["stretched", "lattice"])
 @pytest.mark.parametrize("dx", [0.3, 0.4, 0.5])
-def test_intact_wire_stays_attached_and_a_cut_piece_is_detached(dx):
-    g = scene.build_geometry(window_case(resolution_mm=dx, wire_length_mm=4.0))
+def test_intact_wire_stays_attached_and_a_cut_piece_is_detached(dx, packing):
+    g = scene.build_geometry(window_case(resolution_mm=dx, wire_length_mm=4.0, wire_packing=packing))
     pos, s, s_last = _wire(g)
     link = scene.wire_link_length(g)
     assert not scene.detached_wire(pos, s, s_last, link).any()
@@ -98,3 +99,23 @@ def test_wire_landing_point_is_where_the_fed_tip_meets_the_surface(angle, height
     x_land = low[0] - travel * math.cos(g.wire_angle)
     assert g.wire_landing_x() == pytest.approx(x_land, abs=g.dx)
     assert np.allclose(g.wire_velocity_at(False), 0.0)  # held still relative to the beam before the feed starts
+
+
+@pytest.mark.parametrize("dx", [0.2, 0.3, 0.4, 0.5])
+def test_both_wire_packings_carry_the_nominal_wire_mass(dx):
+    """Particles per unit length of wire x dx^3 = the nominal area: the stretched wire by its slice pitch, the
+    lattice-packed one by its slice counts, with slices dx apart and no point further out than r + dx/2."""
+    area = math.pi * 0.6e-3 ** 2  # d 1.2 mm, Table 4
+    for packing in ("stretched", "lattice"):
+        g = scene.build_geometry(window_case(resolution_mm=dx, wire_length_mm=8.0, wire_diameter_mm=1.2,
+                                             wire_packing=packing))
+        pos, s_last, n_slices = scene.initial_wire(g)
+        pitch = scene.wire_slice_pitch(g)
+        tol = 0.03 if packing == "lattice" else 1e-9
+        assert len(pos) * g.dx ** 3 / (n_slices * pitch) == pytest.approx(area, rel=tol)
+    assert pitch == g.dx
+    axis_dist = np.linalg.norm(np.cross(pos - np.array([0.0, 0.0, g.wire_height]), g.wire_axis), axis=1)
+    assert axis_dist.max() <= 0.6e-3 + g.dx / 2
+    # lattice-packed: every particle has its axial neighbour one dx along (the section varies only at the rim)
+    s = (pos - np.array([0.0, 0.0, g.wire_height])) @ g.wire_axis
+    assert np.allclose(np.diff(np.unique(np.round(s / g.dx, 6))), 1.0)

@@ -432,6 +432,7 @@ class RunState:
     t: float = 0.0
     step: int = 0
     wire_s_last: float = 0.0
+    wire_slices: int = 0  # slices created so far (they pick the points of a lattice-packed wire)
     next_id: int = 1
     ledger: Ledger = field(default_factory=Ledger)
     steps_since_shepard: int = 0
@@ -550,7 +551,7 @@ class BeadRun:
         self.state.next_id = n_sub + 1
         if self.p["wire_feed_start"] == "immediate":
             self.state.feed_start_t = 0.0
-        wire, s_last = scene.initial_wire(g)
+        wire, s_last, self.state.wire_slices = scene.initial_wire(g)
         self.state.wire_s_last = s_last
         self._create_wire_atoms(wire)
         self.per_id.grow(self.state.next_id)
@@ -653,9 +654,10 @@ class BeadRun:
                f"{n.expected_speed:.3g} m/s), limits: {lim}; dt = {self.p['dt_factor']:.3g} x min = {n.dt:.3g} s; "
                f"block {self.geom.x_hi - self.geom.x_lo:.4g} x {self.geom.y_hi - self.geom.y_lo:.4g} x "
                f"{-self.geom.z_lo:.4g} m, cut faces {self.geom.cut_faces}, {self.lmp.get_natoms()} particles")
-        n_slice = scene.wire_slice_count(self.geom)
         nominal = math.pi * self.geom.wire_radius ** 2
-        msg += (f"; wire slice {n_slice} particles = {n_slice * n.dx ** 2 * 1e6:.3g} mm2 for a nominal "
+        n_slice = (scene.wire_slice_count(self.geom) if self.geom.wire_packing == "stretched"
+                   else nominal / n.dx ** 2)
+        msg += (f"; wire slice {n_slice:.3g} particles = {n_slice * n.dx ** 2 * 1e6:.3g} mm2 for a nominal "
                 f"{nominal * 1e6:.3g} mm2, slices {scene.wire_slice_pitch(self.geom) * 1e3:.3g} mm apart")
         if self.p["shepard_interval"] and not self.shepard:
             msg += "; no Shepard filter with surface tension (it lets the cohesive liquid expand)"
@@ -730,7 +732,8 @@ class BeadRun:
         while st.wire_s_last + pitch <= g.wire_length:
             st.wire_s_last += pitch
             # the slice enters at the feed end of the wire as it is at the start of the next chunk
-            pos = scene.wire_slice(g, st.wire_s_last, g.beam_x(st.t))
+            pos = scene.wire_slice(g, st.wire_s_last, g.beam_x(st.t), st.wire_slices)
+            st.wire_slices += 1
             self._create_wire_atoms(pos)
             created = True
         return created
