@@ -48,7 +48,7 @@ METRICS: dict[str, tuple[str, str]] = {
     "density_min": ("1", "minimum liquid density / rho0"),
     "density_max": ("1", "maximum liquid density / rho0"),
     "liquid_packing": ("1", "kernel fill of the melt / lattice's, 90th percentile over the last 0.25 s (SPH; "
-                       "well below 1: the liquid expanded)"),
+                       "well below 1: expanded, or a melt without a kernel-wide interior)"),
     "spatter_particles": ("1", "fluid particles deleted after leaving the modelled block"),
     "wire_feed_start_s": ("s", "process time the wire feed started (NaN: never)"),
     "wire_released_particles": ("1", "unmelted wire particles cut off from the fed wire (fell free)"),

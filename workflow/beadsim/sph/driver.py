@@ -199,13 +199,6 @@ def is_rank0(lmp) -> bool:
     return lmp.extract_setting("world_rank") == 0
 
 
-#: Kernel fill of the melt (:meth:`BeadRun._liquid_packing`) below which a run warns that its liquid expanded.
-#: Measured at dx 0.4 (mode 1, 90th percentile): 1.00 without surface tension; with it 0.81-0.97 (the
-#: melted wire is under-packed: its slices lie 1.27 dx apart to carry the nominal mass, see
-#: scene.wire_slice_pitch), and 0.63-0.75 with it and the Shepard filter (the expanded case).
-LIQUID_PACKING_WARN = 0.85
-
-
 def allreduce(lmp, value, op: str = "sum"):
     """Global sum / max / min of a number or array over MPI ranks; a no-op on one rank.
 
@@ -962,9 +955,12 @@ class BeadRun:
 
     def _liquid_packing(self) -> float:
         """Kernel fill of the melt: the 90th percentile over the molten particles of sum_j dx^3 W_ij over the
-        lattice's (:func:`compression_density` / rho0, last chunk). About 1 in a melt packed like the lattice
-        (free-surface particles lie below, which the percentile skips); well below 1 the liquid has expanded
-        while its density variable did not follow. NaN without melt."""
+        lattice's (:func:`compression_density` / rho0, last chunk). About 1 in a pool inside the solid packed
+        like the lattice; well below 1 the liquid has expanded while its density variable did not follow (mode 1
+        with surface tension and the Shepard filter: 0.63-0.75; without either, 1.00), or the melt has no
+        interior a kernel wide: a capillary cap 1-2 mm tall reads 0.7-0.9 when packed (measured: a bead of
+        lattice-packed wire, whose area matches its mass, 0.71 at the end against 0.95 while the melt lay in
+        the substrate). NaN without melt."""
         fill = allgather_rows(self.lmp, self.liquid_packing_local)
         return float(np.percentile(fill, 90)) if len(fill) else np.nan
 
@@ -1360,10 +1356,6 @@ class BeadRun:
         packing = [m["liquid_packing"] for m in self.series
                    if "liquid_packing" in m and m["t"] > st.t - 0.25 - 1e-9 and np.isfinite(m["liquid_packing"])]
         out["liquid_packing"] = float(np.mean(packing)) if packing else np.nan
-        if out["liquid_packing"] < LIQUID_PACKING_WARN and self.rank0:
-            log.warning("the melt is under-packed: its kernel fill (90th percentile, last 0.25 s) is %.2f of "
-                        "the lattice's while its density variable stays near rho0 (more volume than its mass)",
-                        out["liquid_packing"])
         if not partial:
             out.update(self._bead_metrics(out["wire_supply_area_mm2"]))
             checks = [m for m in self.series if np.isfinite(m.get("mass_balance_ratio", np.nan))][-3:]
