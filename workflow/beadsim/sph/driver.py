@@ -956,8 +956,8 @@ class BeadRun:
     def _liquid_packing(self) -> float:
         """Kernel fill of the melt: the 90th percentile over the molten particles of sum_j dx^3 W_ij over the
         lattice's (:func:`compression_density` / rho0, last chunk). About 1 in a pool inside the solid packed
-        like the lattice; well below 1 the liquid has expanded while its density variable did not follow (mode 1
-        with surface tension and the Shepard filter: 0.63-0.75; without either, 1.00), or the melt has no
+        like the lattice; well below 1 the liquid has expanded while its density variable did not follow
+        (mode 1 with surface tension and the Shepard filter: 0.63-0.75; without either, 1.00), or the melt has no
         interior a kernel wide: a capillary cap 1-2 mm tall reads 0.7-0.9 when packed (measured: a bead of
         lattice-packed wire, whose area matches its mass, 0.71 at the end against 0.95 while the melt lay in
         the substrate). NaN without melt."""
