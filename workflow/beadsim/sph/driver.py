@@ -490,7 +490,7 @@ class BeadRun:
         self.speed_limit = params["speed_limit_m_s"] or 0.5 * self.num.c0
         # The Shepard filter holds the density of a cohesive liquid at rho0 while it expands under the positive
         # background pressure of the shifted Tait equation (tension.py): mode 1 with surface tension at dx 0.4,
-        # 0.3 s, the melt's kernel fill (liquid_packing) was 0.70 with the filter and 0.93 without, and over 2 s
+        # 0.3 s, the melt's kernel fill (liquid_packing) was 0.75 with the filter and 0.93 without, and over 2 s
         # the melt puffed up into a mound 2-3 mm tall at 1.3 dx spacing. The drop tests that verify the
         # cohesion model run without it.
         self.shepard = bool(params["shepard_interval"]) and self.num.cohesion is None
@@ -658,9 +658,9 @@ class BeadRun:
         self.deck.note(msg)
         stretch = scene.wire_slice_pitch(self.geom) / n.dx
         if n.cohesion is not None and self.geom.wire_packing == "stretched" and stretch > 1.05:
-            log.warning("surface tension with a stretched wire (slices %.2f dx apart): its melt keeps %.0f %% more "
-                        "volume than its mass fills (beads measured 1.26-1.28x at dx 0.4); use wire_packing: "
-                        "lattice", stretch, 100 * (stretch - 1))
+            log.warning("surface tension with a stretched wire (slices %.2f dx apart): its melt can keep up to "
+                        "%.0f %% more volume than its mass fills (beads of it measured 1.26-1.28x at dx 0.4); "
+                        "wire_packing: lattice feeds a lattice-packed wire", stretch, 100 * (stretch - 1))
         if self.p["beam_profile"] == "scan":
             rev = self.p["scan_frequency_Hz"] * self.chunk * n.dt
             log.info("scan: one chunk spans %.3g beam revolutions; its energy is spread over the arc swept", rev)
