@@ -648,15 +648,15 @@ class BeadRun:
                f"block {self.geom.x_hi - self.geom.x_lo:.4g} x {self.geom.y_hi - self.geom.y_lo:.4g} x "
                f"{-self.geom.z_lo:.4g} m, cut faces {self.geom.cut_faces}, {self.lmp.get_natoms()} particles")
         nominal = math.pi * self.geom.wire_radius ** 2
-        n_slice = (scene.wire_slice_count(self.geom) if self.geom.wire_packing == "stretched"
-                   else nominal / n.dx ** 2)
+        pitch = scene.wire_slice_pitch(self.geom)
+        n_slice = nominal * pitch / n.dx ** 3  # mean particles per slice
         msg += (f"; wire slice {n_slice:.3g} particles = {n_slice * n.dx ** 2 * 1e6:.3g} mm2 for a nominal "
-                f"{nominal * 1e6:.3g} mm2, slices {scene.wire_slice_pitch(self.geom) * 1e3:.3g} mm apart")
+                f"{nominal * 1e6:.3g} mm2, slices {pitch * 1e3:.3g} mm apart")
         if self.p["shepard_interval"] and not self.shepard:
             msg += "; no Shepard filter with surface tension (it lets the cohesive liquid expand)"
         log.info(msg)
         self.deck.note(msg)
-        stretch = scene.wire_slice_pitch(self.geom) / n.dx
+        stretch = pitch / n.dx
         if n.cohesion is not None and self.geom.wire_packing == "stretched" and stretch > 1.05:
             log.warning("surface tension with a stretched wire (slices %.2f dx apart): its melt can keep up to "
                         "%.0f %% more volume than its mass fills (beads of it measured 1.26-1.28x at dx 0.4); "
