@@ -622,6 +622,8 @@ class BeadRun:
         else:  # cohesion acts by type: melt and freeze at chunk ends, when the types switch
             cmd(f"variable frozen atom type!={TYPE_LIQUID}&&type!={TYPE_FALLING}")
         cmd("group frozen dynamic all var frozen every 1")
+        if p["resolidified_density"] == "freeze":  # after read_restart, the same ID restores the values
+            cmd("fix rhofreeze all property/atom d_rhofreeze ghost no")
         if self.geom.moving_window and not self.lmp.has_id("region", "behind"):
             cmd(f"region behind block INF {self.geom.x_lo:.9g} INF INF INF INF units box")
         cmd("fix integrate all sph")
@@ -869,6 +871,11 @@ class BeadRun:
             new_types[released[ids] & ~melted] = TYPE_SUBSTRATE  # landed: solid moving with the substrate
             new_types[falling] = TYPE_FALLING
         changed = allreduce(self.lmp, int((new_types != types).sum())) > 0
+        keep_freeze = self.p["resolidified_density"] == "freeze"
+        if keep_freeze:  # a per-atom LAMMPS property: it moves with the atom between ranks and into restarts
+            rho_freeze = self.lmp.numpy.extract_atom("d_rhofreeze")
+            froze = (types == TYPE_LIQUID) & ~liquid
+            rho_freeze[froze] = self._rho()[froze]
         types[:] = new_types
         frozen = ~liquid & (new_types != TYPE_FALLING)
         target = np.where(types[frozen, None] == TYPE_WIRE, self._wire_velocity(), self.geom.substrate_velocity)
@@ -880,7 +887,11 @@ class BeadRun:
         if self.p["solid_density_reset"]:
             # falling (cut-off) wire is solid metal too; its continuity density drifts as it parts from the fed
             # wire (measured: 0.73 rho0 with a full kernel of neighbours, mode 1 at dx 0.2, 0.1 s)
-            self._rho()[~liquid] = self.mat.rho
+            rho = self._rho()
+            rho[~liquid] = self.mat.rho
+            if keep_freeze:  # melted before: the density it froze at (0 = never molten)
+                kept = ~liquid & (rho_freeze > 0)
+                rho[kept] = rho_freeze[kept]
         return temp, changed
 
     def _release_detached(self, ids: np.ndarray, wire: np.ndarray) -> None:

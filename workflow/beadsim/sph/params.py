@@ -92,6 +92,11 @@ SPH_PARAMETERS: list[Param] = [
           "(0 = never); not applied with surface_tension, where it lets the cohesive liquid expand", minimum=0, maximum=100000, short="shep", models=_SPH),
     Param("solid_density_reset", "boolean", True, "", "reset the density of solid particles (frozen, and "
           "falling cut-off wire) to rho0 every chunk", short="sdr", models=_SPH),
+    Param("resolidified_density", "string", "rho0", "", "density the reset gives particles that melted and "
+          "froze again: rho0 (as the never-melted solid) or freeze (the continuity density each had when it "
+          "last froze, so that melt which expanded before freezing remelts at its own density instead of "
+          "being refilled to rho0 at every freeze-melt cycle)", enum=("rho0", "freeze"), short="rsd",
+          models=_SPH),
     Param("stop_at_steady_state", "boolean", False, "", "stop before sim_time_s once the melt count and pool "
           "length (and, in the window domain, the bead width and height) are steady within steady_tolerance",
           short="ss", models=_SPH),
