@@ -182,8 +182,9 @@ def test_refrozen_melt_remelts_at_the_density_it_froze_at(tmp_path, keep):
     continuity density it froze at, and never-melted solid rho0; the value moves with the atom into a restart.
 
     With the reset to rho0, melt that expanded and froze is refilled to rho0 at every freeze-melt cycle at the
-    pool's edge, and the cohesive cap puffs up (mode 2, dx 0.4, harmonic interface: kernel fill of the melt 0.88
-    against 0.71-0.73 at 1.9-2.5 s, see the README). This checks the mechanism on particles set by hand.
+    pool's edge, and the cohesive cap puffs up (mode 2, dx 0.4, harmonic interface: kernel fill of the melt
+    0.86-0.89 at 1.8-2.0 s with ``freeze``, 0.71-0.73 with ``rho0``; see the README). This checks the mechanism on
+    particles set by hand.
     """
     from beadsim.bench import mode_params
     from beadsim.sph.driver import BeadRun
