@@ -664,9 +664,9 @@ class BeadRun:
                         "%.0f %% more volume than its mass fills (beads of it measured 1.26-1.28x at dx 0.4); "
                         "wire_packing: lattice feeds a lattice-packed wire", stretch, 100 * (stretch - 1))
         if n.cohesion is not None and self.p["solid_density_reset"] and self.p["resolidified_density"] == "rho0":
-            log.warning("surface tension with resolidified_density rho0: melt that freezes and remelts is refilled "
-                        "to rho0 at every cycle and the cap puffs up (mode 2 at dx 0.4: 1.5-1.6x the area its particles "
-                        "fill); resolidified_density: freeze keeps the density it froze at")
+            log.warning("surface tension with resolidified_density rho0: melt that freezes and remelts is "
+                        "refilled to rho0 at every cycle and the cap puffs up (mode 2 at dx 0.4: 1.5-1.6x the area "
+                        "its particles fill); resolidified_density: freeze keeps the density it froze at")
         if self.p["beam_profile"] == "scan":
             rev = self.p["scan_frequency_Hz"] * self.chunk * n.dt
             log.info("scan: one chunk spans %.3g beam revolutions; its energy is spread over the arc swept", rev)
