@@ -165,6 +165,8 @@ def test_moving_window_conserves_energy_and_feeds_substrate(tmp_path):
     assert float(np.nanmax(np.abs(closure))) < ENERGY_BALANCE_TOL
     assert abs(m["energy_balance_error"]) < ENERGY_BALANCE_TOL
     assert m["mass_balance_ratio"] == pytest.approx(1.0, abs=MASS_BALANCE_TOL)
+    sections = ts.mass_balance_ratio.values[np.isfinite(ts.mass_balance_ratio.values)]
+    assert m["bead_samples"] == 3 and m["mass_balance_ratio"] == pytest.approx(sections[-3:].mean(), rel=1e-12)
     assert 0 < m["bead_height_mm"] < 3 * params["wire_diameter_mm"] and m["bead_width_mm"] > 0
     dump = sorted((tmp_path / "dumps").glob("*.lammpstrj"), key=lambda f: int(f.name.split(".")[1]))[-1]
     lines = dump.read_text().splitlines()
@@ -176,6 +178,43 @@ def test_moving_window_conserves_energy_and_feeds_substrate(tmp_path):
     dx = params["resolution_mm"] * 1e-3
     phase = (atoms[ahead, 2] / dx) % 1.0
     assert np.ptp(np.minimum(phase, 1 - phase) if np.ptp(phase) > 0.5 else phase) < 1e-6  # one lattice in x
+
+
+@pytest.mark.parametrize("n_sections", [3, 5])
+def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_sections):
+    """``bead_sections``: in the moving window the final bead is the mean height profile (and mean mass balance)
+    of the last ``bead_sections`` cross-sections, with the spread of their widths and heights. The sections here
+    are synthetic caps of known size (a humping bead: narrow and wide in turn), fed through the driver's
+    section check on a real (tiny) LAMMPS scene."""
+    from beadsim.sph import surface
+    from beadsim.sph.driver import BeadRun
+
+    run = BeadRun(small_case(domain="window", window_thermal_lengths=4.0, sim_time_s=0.01,
+                             bead_sections=n_sections), tmp_path)
+    run.open(resume=False)
+    dx = run.num.dx
+    y = np.arange(-10, 11) * dx
+    caps = [(4, 2), (7, 4), (5, 3), (8, 5), (4, 2), (6, 3)]  # (half-width, height) in spacings, old to new
+    ratios = [0.7, 1.3, 0.9, 1.2, 0.8, 1.1]
+    profiles = [np.clip(hgt * dx * (1 - (y / ((half + 0.5) * dx)) ** 2), 0.0, None) for half, hgt in caps]
+    for i, (h, ratio) in enumerate(zip(profiles, ratios)):
+        section = {"mass_balance_ratio": ratio, "penetration_depth_mm": 0.1 * i, "fusion_width_mm": 3.0,
+                   **surface.profile_metrics(y, h, dx), "profile": (y, h)}
+        monkeypatch.setattr(run, "_bead_metrics", lambda supply, s=section: dict(s))
+        run.series.append({"t": 0.05 * (i + 1), **run._bead_check()})
+    m = run._metrics()
+    last = slice(len(caps) - n_sections, None)
+    mean = surface.profile_metrics(y, np.mean(profiles[last], axis=0), dx)
+    widths = [surface.profile_metrics(y, h, dx)["bead_width_mm"] for h in profiles[last]]
+    heights = [hgt * dx * 1e3 for _, hgt in caps[last]]
+    assert m["bead_samples"] == n_sections
+    assert m["bead_width_mm"] == pytest.approx(mean["bead_width_mm"], rel=1e-12)
+    assert m["bead_height_mm"] == pytest.approx(mean["bead_height_mm"], rel=1e-12)
+    assert m["mass_balance_ratio"] == pytest.approx(np.mean(ratios[last]), rel=1e-12)
+    assert m["penetration_depth_mm"] == pytest.approx(np.mean([0.1 * i for i in range(6)][last]), rel=1e-12)
+    assert m["bead_width_sd_mm"] == pytest.approx(np.std(widths, ddof=1), rel=1e-12) and m["bead_width_sd_mm"] > 0
+    assert m["bead_height_sd_mm"] == pytest.approx(np.std(heights, ddof=1), rel=1e-9)
+    assert m["mass_balance_sd"] == pytest.approx(np.std(ratios[last], ddof=1), rel=1e-12)
 
 
 def test_enhanced_melt_conductivity_spreads_the_heat_and_keeps_the_ledger(small_bead, tmp_path):

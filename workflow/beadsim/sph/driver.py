@@ -56,6 +56,10 @@ DENSITY_MARGIN = 0.01  # allowed hydrostatic density error g H / c0^2 for the au
 #: 0.01 s of process it cost ~4 % of a dx 0.4 run). Also written at every checkpoint and at the end.
 SERIES_WRITE_INTERVAL_S = 20.0
 POOL_KEYS = ("pool_length_mm", "pool_width_mm", "pool_depth_mm", "pool_volume_mm3")
+#: Per-section bead values whose spread (standard deviation over the averaged sections) is reported: a bead that
+#: humps has a steady mean only over a stretch longer than a hump.
+SECTION_SPREAD = {"bead_width_mm": "bead_width_sd_mm", "bead_height_mm": "bead_height_sd_mm",
+                  "mass_balance_ratio": "mass_balance_sd"}
 
 
 # ----------------------------------------------------------------------------------------------- numerics
@@ -481,7 +485,7 @@ class BeadRun:
         self.lammps_time = 0.0
         self.bead_time = 0.0
         self.series_written = -math.inf  # wall clock of the last time-series write
-        self.profiles: list = []  # (y, h) of the last bead sections (moving window)
+        self.profiles: list = []  # (y, h) of the last bead_sections bead sections (moving window)
         self.particle_steps = 0.0
         self.t_end = params["sim_time_s"]
         self.chunk = int(params["chunk_steps"])
@@ -1227,7 +1231,7 @@ class BeadRun:
                 "penetration_depth_mm", "fusion_width_mm") + POOL_KEYS
         out = self._bead_metrics(self._supply_mm2())
         if "profile" in out:
-            self.profiles = (self.profiles + [out["profile"]])[-3:]
+            self.profiles = (self.profiles + [out["profile"]])[-int(self.p["bead_sections"]):]
         return {k: float(out.get(k, np.nan)) for k in keys}
 
     def _supply_mm2(self) -> float:
@@ -1378,11 +1382,17 @@ class BeadRun:
         out["liquid_packing"] = float(np.mean(packing)) if packing else np.nan
         if not partial:
             out.update(self._bead_metrics(out["wire_supply_area_mm2"]))
-            checks = [m for m in self.series if np.isfinite(m.get("mass_balance_ratio", np.nan))][-3:]
+            n_sections = int(p["bead_sections"])
+            checks = [m for m in self.series if np.isfinite(m.get("mass_balance_ratio", np.nan))][-n_sections:]
             if self.geom.moving_window and checks and self.profiles:
-                # steady state: the mean of the last three cross-sections (0.05 s apart)
+                # the mean of the last bead_sections cross-sections (0.05 s apart; three by default)
                 for key in ("mass_balance_ratio", "penetration_depth_mm", "fusion_width_mm"):
                     out[key] = float(np.nanmean([c.get(key, np.nan) for c in checks]))
+                for key, sd_key in SECTION_SPREAD.items():
+                    v = np.array([c.get(key, np.nan) for c in checks], dtype=float)
+                    v = v[np.isfinite(v)]
+                    out[sd_key] = float(v.std(ddof=1)) if len(v) > 1 else np.nan
+                out["bead_samples"] = len(checks)
                 out.update(self._pool_means())
                 y = self.profiles[-1][0]
                 same = [h for yy, h in self.profiles if len(yy) == len(y) and np.allclose(yy, y)]

@@ -63,6 +63,10 @@ SPH_PARAMETERS: list[Param] = [
     Param("window_bead_mm", "number", 1.5, "mm", "domain window: length of solid bead kept behind the melt "
           "pool (the cross-section is averaged over it)", minimum=0.2, maximum=20, short="wB", models=_SPH,
           long_name="window bead length"),
+    Param("bead_sections", "integer", 3, "1", "domain window: bead cross-sections (taken every 0.05 s) whose "
+          "mean height profile, mass balance, penetration and fused width make the final bead; more than three "
+          "average a bead that humps or varies over a longer stretch", minimum=1, maximum=200, short="nB",
+          models=_SPH, long_name="bead sections averaged"),
     Param("domain_margin_mm", "number", 3.0, "mm", "margin of the auto block around the scanned track and the "
           "wire", minimum=0.5, maximum=50, short="marg", models=_SPH, long_name="domain margin"),
     Param("domain_depth_mm", "number", 3.0, "mm", "thickness of the auto block (at most the plate thickness)",
