@@ -215,6 +215,11 @@ def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_s
     assert m["bead_width_sd_mm"] == pytest.approx(np.std(widths, ddof=1), rel=1e-12) and m["bead_width_sd_mm"] > 0
     assert m["bead_height_sd_mm"] == pytest.approx(np.std(heights, ddof=1), rel=1e-9)
     assert m["mass_balance_sd"] == pytest.approx(np.std(ratios[last], ddof=1), rel=1e-12)
+    # stop_at_steady_state waits for bead_sections steady sections: the three that made it steady and later ones
+    run.state.steady_time = 0.25  # steady with the sections at 0.15-0.25 s, one more taken since
+    assert run._steady_sections_done() == (n_sections <= 4)
+    run.state.steady_time = 0.2
+    assert run._steady_sections_done()
 
 
 def test_enhanced_melt_conductivity_spreads_the_heat_and_keeps_the_ledger(small_bead, tmp_path):

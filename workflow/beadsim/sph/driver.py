@@ -1210,7 +1210,7 @@ class BeadRun:
                 self._report(m)
                 if now - self.series_written >= SERIES_WRITE_INTERVAL_S:
                     self._write_series()
-                if self._steady() and p["stop_at_steady_state"]:
+                if self._steady() and p["stop_at_steady_state"] and self._steady_sections_done():
                     break
             if st.t >= st.t_next_restart - 0.5 * dt_chunk:
                 self.checkpoint()
@@ -1283,6 +1283,15 @@ class BeadRun:
         st.steady_time = st.t
         log.info("steady state at t = %.3f s", st.t)
         return True
+
+    def _steady_sections_done(self) -> bool:
+        """At steady state, whether the bead sections to average (``bead_sections``, moving window) are all
+        steady ones: the three that made the run steady and those taken since (so three stop at once)."""
+        if not self.geom.moving_window:
+            return True
+        since = sum(1 for m in self.series
+                    if m["t"] >= self.state.steady_time - 1e-12 and np.isfinite(m.get("mass_balance_ratio", np.nan)))
+        return since + 2 >= int(self.p["bead_sections"])
 
     # ---- outputs
     def _write_series(self) -> None:
