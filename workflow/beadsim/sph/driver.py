@@ -58,6 +58,8 @@ SERIES_WRITE_INTERVAL_S = 20.0
 POOL_KEYS = ("pool_length_mm", "pool_width_mm", "pool_depth_mm", "pool_volume_mm3")
 #: Per-section bead values whose spread (standard deviation over the averaged sections) is reported: a bead that
 #: humps has a steady mean only over a stretch longer than a hump.
+#: Bead sections (0.05 s apart) whose mass balance makes the moving window steady.
+STEADY_SECTIONS = 3
 SECTION_SPREAD = {"bead_width_mm": "bead_width_sd_mm", "bead_height_mm": "bead_height_sd_mm",
                   "mass_balance_ratio": "mass_balance_sd"}
 
@@ -1272,8 +1274,8 @@ class BeadRun:
             return True
         if self.geom.moving_window:  # mass steady: the bead leaving carries what the wire brings
             ratio = np.array([c.get("mass_balance_ratio", np.nan) for c in self.series
-                              if "mass_balance_ratio" in c][-3:], dtype=float)
-            if len(ratio) < 3 or not (np.abs(ratio - 1) < tol).all():
+                              if "mass_balance_ratio" in c][-STEADY_SECTIONS:], dtype=float)
+            if len(ratio) < STEADY_SECTIONS or not (np.abs(ratio - 1) < tol).all():
                 return False
         if st.t < max(2 * beam_footprint_radius(self.p) / self.geom.substrate_speed, 2 * window):
             return False
@@ -1298,7 +1300,7 @@ class BeadRun:
             return True
         since = sum(1 for m in self.series
                     if m["t"] >= self.state.steady_time - 1e-12 and np.isfinite(m.get("mass_balance_ratio", np.nan)))
-        return since + 2 >= int(self.p["bead_sections"])
+        return since + STEADY_SECTIONS - 1 >= int(self.p["bead_sections"])
 
     # ---- outputs
     def _write_series(self) -> None:

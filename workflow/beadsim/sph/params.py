@@ -66,8 +66,8 @@ SPH_PARAMETERS: list[Param] = [
     Param("bead_sections", "integer", 3, "1", "domain window: bead cross-sections (taken every 0.05 s) whose "
           "mean height profile, mass balance, penetration and fused width make the final bead; more than three "
           "average a bead that humps or varies over a longer stretch (stop_at_steady_state then runs on until "
-          "that many sections are steady ones: the three that made it steady and those after)", minimum=1, maximum=200, short="nB",
-          models=_SPH, long_name="bead sections averaged"),
+          "that many sections are steady ones: the three that made it steady and those after)", minimum=1,
+          maximum=200, short="nB", models=_SPH, long_name="bead sections averaged"),
     Param("domain_margin_mm", "number", 3.0, "mm", "margin of the auto block around the scanned track and the "
           "wire", minimum=0.5, maximum=50, short="marg", models=_SPH, long_name="domain margin"),
     Param("domain_depth_mm", "number", 3.0, "mm", "thickness of the auto block (at most the plate thickness)",
