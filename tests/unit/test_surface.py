@@ -201,3 +201,43 @@ def test_fusion_width_between_lattice_steps():
     half = np.where(pos[:, 0] < 1e-3, 1.5e-3, 1.6e-3)
     melted = (np.abs(pos[:, 1]) < half) & (pos[:, 2] > -3 * DX)
     assert fusion_width(pos, melted, DX, WINDOW) == pytest.approx(3.1, abs=1e-9)
+
+
+def test_mean_profile_aligns_maps_on_whole_bins():
+    """Maps taken at different times: the melt shifts the lattice phase by a fraction of a spacing and a stray
+    particle widens the extent; the mean is bin by bin on the union, a map on another lattice is left out."""
+    from beadsim.sph.surface import mean_profile
+
+    dx = 4e-4
+    h1 = np.array([0.0, 1.0, 2.0, 3.0, 2.0, 1.0, 0.0]) * dx
+    h2 = np.array([np.nan, 0.0, 0.0, 2.0, 3.0, 4.0, 3.0, 2.0, 0.0]) * dx  # two bins more on the left
+    y1 = np.arange(7) * dx + 0.013 * dx
+    y2 = (np.arange(9) - 2) * dx - 0.021 * dx
+    y_other = np.arange(7) * dx + 0.5 * dx  # half a spacing off: another lattice
+    y, h, n_used = mean_profile([(y1, h1), (y_other, h1), (y2, h2)], dx)
+    assert n_used == 2
+    np.testing.assert_allclose(y, y2, rtol=0, atol=1e-12 * dx)  # the last map's bins
+    expected = np.concatenate([h2[:2], 0.5 * (h1 + h2[2:])])
+    np.testing.assert_allclose(h[1:], expected[1:], rtol=1e-12)
+    assert np.isnan(h[0])  # empty in every map that has the bin
+
+
+def test_mean_profile_of_jittered_maps_of_one_cap_is_that_cap():
+    """Height maps of one cap from clouds jittered differently (phases differ by ~1e-3 dx): all go into the
+    mean, whose width and height are those of a single map within a spacing."""
+    from beadsim.sph.surface import mean_profile, profile_metrics
+
+    maps = []
+    for seed in (1, 2, 3):
+        pos = bead_cloud(60, jitter=0.2, seed=seed)
+        if seed == 3:  # a stray particle beside the plate widens this map's extent by a few bins
+            pos = np.vstack([pos, [[1e-3, 3.35e-3, -0.5e-3]]])
+        maps.append(height_map(pos, DX, WINDOW))
+    assert not np.allclose(maps[0][0][:5], maps[1][0][:5], rtol=0, atol=1e-10)  # not the same bins
+    y, h, n_used = mean_profile(maps, DX)
+    assert n_used == 3
+    one = profile_metrics(*maps[0], DX)
+    mean = profile_metrics(y, h, DX)
+    _, height, _ = cap_shape(WIDTH, 60)
+    assert mean["bead_width_mm"] == pytest.approx(one["bead_width_mm"], abs=DX * 1e3)
+    assert mean["bead_height_mm"] == pytest.approx(height * 1e3, abs=0.5 * DX * 1e3)

@@ -1412,10 +1412,12 @@ class BeadRun:
                     out[sd_key] = float(v.std(ddof=1)) if len(v) > 1 else np.nan
                 out["bead_samples"] = len(checks)
                 out.update(self._pool_means())
-                y = self.profiles[-1][0]
-                same = [h for yy, h in self.profiles if len(yy) == len(y) and np.allclose(yy, y)]
+                y, h, n_used = surface.mean_profile(self.profiles, self.num.dx)
+                if n_used < len(self.profiles):
+                    log.warning("bead: %d of %d sections are on another lattice and were left out of the mean",
+                                len(self.profiles) - n_used, len(self.profiles))
                 with np.errstate(all="ignore"):
-                    out.update(surface.profile_metrics(y, np.nanmean(same, axis=0), self.num.dx))
+                    out.update(surface.profile_metrics(y, h, self.num.dx))
                 if out.get("bead_width_mm"):
                     out["aspect_ratio"] = out["bead_height_mm"] / out["bead_width_mm"]
                 log.info("bead: mean profile of the sections at t = %s s", ", ".join(f"{c['t']:.3f}" for c in checks))

@@ -16,6 +16,8 @@ Lengths returned in metres by :func:`height_map`; the dictionaries use the metri
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
@@ -223,6 +225,45 @@ def profile_metrics(y: np.ndarray, h: np.ndarray, dx: float) -> dict:
         "bead_area_mm2": area * 1e6,
         "contact_angle_deg": arc_contact_angle(*_with_edges(y[run], h[run], dx)),
     }
+
+
+def mean_profile(profiles: list, dx: float) -> tuple[np.ndarray, np.ndarray, int]:
+    """Mean of height profiles ``[(y, h), ...]`` taken at different times, bin by bin.
+
+    The bins of each map follow the lattice phase of the particles in its window, which the melt in it moves by
+    a small fraction of a spacing from one map to the next, and its extent follows the outermost particle; so
+    the maps are aligned on whole bins relative to the last one (the reference) on the union of their extents,
+    and a bin missing or empty in a map does not count in that bin's mean. A map whose bins are offset from the
+    reference's by more than a quarter spacing (not the same lattice) is left out.
+
+    Returns
+    -------
+    y : (ny,) array, m
+        Bin centres (the reference's phase).
+    h : (ny,) array, m
+        Mean height (NaN where every map is empty).
+    n_used : int
+        Maps that went into the mean.
+    """
+    y_ref = np.asarray(profiles[-1][0], dtype=float)
+    placed = []
+    for y, h in profiles:
+        y, h = np.asarray(y, dtype=float), np.asarray(h, dtype=float)
+        if not len(y):
+            continue
+        offset = (y[0] - y_ref[0]) / dx
+        if abs(offset - np.rint(offset)) > 0.25:
+            continue
+        placed.append((int(np.rint(offset)), h))
+    lo = min(k for k, _ in placed)
+    hi = max(k + len(h) for k, h in placed)
+    table = np.full((len(placed), hi - lo), np.nan)
+    for row, (k, h) in enumerate(placed):
+        table[row, k - lo:k - lo + len(h)] = h
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN bins stay NaN
+        h_mean = np.nanmean(table, axis=0)
+    return y_ref[0] + np.arange(lo, hi) * dx, h_mean, len(placed)
 
 
 def largest_cluster(pos: np.ndarray, dx: float, link: float = 1.5) -> np.ndarray:
