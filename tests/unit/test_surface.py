@@ -214,12 +214,14 @@ def test_mean_profile_aligns_maps_on_whole_bins():
     y1 = np.arange(7) * dx + 0.013 * dx
     y2 = (np.arange(9) - 2) * dx - 0.021 * dx
     y_other = np.arange(7) * dx + 0.5 * dx  # half a spacing off: another lattice
-    y, h, n_used = mean_profile([(y1, h1), (y_other, h1), (y2, h2)], dx)
+    empty = (np.empty(0), np.empty(0))  # a window without particles
+    y, h, n_used = mean_profile([(y1, h1), (y_other, h1), (y2, h2), empty], dx)
     assert n_used == 2
     np.testing.assert_allclose(y, y2, rtol=0, atol=1e-12 * dx)  # the last map's bins
     expected = np.concatenate([h2[:2], 0.5 * (h1 + h2[2:])])
     np.testing.assert_allclose(h[1:], expected[1:], rtol=1e-12)
     assert np.isnan(h[0])  # empty in every map that has the bin
+    assert mean_profile([empty], dx)[2] == 0
 
 
 def test_mean_profile_of_jittered_maps_of_one_cap_is_that_cap():

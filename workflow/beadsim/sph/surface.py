@@ -234,7 +234,7 @@ def mean_profile(profiles: list, dx: float) -> tuple[np.ndarray, np.ndarray, int
     a small fraction of a spacing from one map to the next, and its extent follows the outermost particle; so
     the maps are aligned on whole bins relative to the last one (the reference) on the union of their extents,
     and a bin missing or empty in a map does not count in that bin's mean. A map whose bins are offset from the
-    reference's by more than a quarter spacing (not the same lattice) is left out.
+    reference's by more than a quarter spacing (not the same lattice) is left out, and so is an empty map.
 
     Returns
     -------
@@ -245,12 +245,12 @@ def mean_profile(profiles: list, dx: float) -> tuple[np.ndarray, np.ndarray, int
     n_used : int
         Maps that went into the mean.
     """
-    y_ref = np.asarray(profiles[-1][0], dtype=float)
+    maps = [(np.asarray(y, dtype=float), np.asarray(h, dtype=float)) for y, h in profiles if len(y)]
+    if not maps:  # no particles in any window
+        return np.empty(0), np.empty(0), 0
+    y_ref = maps[-1][0]
     placed = []
-    for y, h in profiles:
-        y, h = np.asarray(y, dtype=float), np.asarray(h, dtype=float)
-        if not len(y):
-            continue
+    for y, h in maps:
         offset = (y[0] - y_ref[0]) / dx
         if abs(offset - np.rint(offset)) > 0.25:
             continue
