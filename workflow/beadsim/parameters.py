@@ -56,7 +56,8 @@ PARAMETERS: list[Param] = [
           exclusive_minimum=0, maximum=5, short="sig", long_name="beam spot radius"),
     Param("substrate_speed_mm_s", "number", 5.0, "mm s-1", "substrate travel speed V_s", exclusive_minimum=0,
           maximum=100, short="Vs", long_name="substrate speed"),
-    Param("wire_feed_mm_s", "number", 10.0, "mm s-1", "wire feed rate V_w", minimum=0, maximum=200, short="Vw",
+    Param("wire_feed_mm_s", "number", 10.0, "mm s-1", "wire feed rate V_w; 0 = a beam-only pass (the SPH scene "
+          "then has no wire)", minimum=0, maximum=200, short="Vw",
           long_name="wire feed rate"),
     Param("wire_diameter_mm", "number", 1.2, "mm", "wire diameter d", exclusive_minimum=0, maximum=5, short="d",
           long_name="wire diameter"),

@@ -557,9 +557,10 @@ class BeadRun:
         self.state.next_id = n_sub + 1
         if self.p["wire_feed_start"] == "immediate":
             self.state.feed_start_t = 0.0
-        wire, s_last, self.state.wire_slices = scene.initial_wire(g)
-        self.state.wire_s_last = s_last
-        self._create_wire_atoms(wire)
+        if g.wire_feed > 0:  # no feed: a beam-only pass, without a wire in the scene
+            wire, s_last, self.state.wire_slices = scene.initial_wire(g)
+            self.state.wire_s_last = s_last
+            self._create_wire_atoms(wire)
         self.per_id.grow(self.state.next_id)
         ids, x = self._ids(), self._x()
         self.per_id.face_area[ids] = scene.face_areas(g, x) * (self._types() == TYPE_SUBSTRATE)
@@ -739,6 +740,8 @@ class BeadRun:
     def _feed_wire(self) -> bool:
         """Advance the wire feed end; create the slices that entered. True if atoms were created."""
         g, st = self.geom, self.state
+        if g.wire_feed <= 0:
+            return False
         if not self.feeding:
             self._start_feed_on_pool()
             if not self.feeding:
@@ -1272,7 +1275,7 @@ class BeadRun:
         tol = self.p["steady_tolerance"]
         if math.isfinite(st.steady_time):
             return True
-        if self.geom.moving_window:  # mass steady: the bead leaving carries what the wire brings
+        if self.geom.moving_window and self._supply_mm2() > 0:  # mass steady: the bead carries the wire's metal
             ratio = np.array([c.get("mass_balance_ratio", np.nan) for c in self.series
                               if "mass_balance_ratio" in c][-STEADY_SECTIONS:], dtype=float)
             if len(ratio) < STEADY_SECTIONS or not (np.abs(ratio - 1) < tol).all():
@@ -1498,7 +1501,7 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
         nx, ny, nz = geom.counts()
         n_before = n_cells * ny * nz
         net_area = (int(in_win.sum()) - n_before) * geom.dx ** 3 / length * 1e6
-    out["mass_balance_ratio"] = net_area / supply_mm2
+    out["mass_balance_ratio"] = net_area / supply_mm2 if supply_mm2 > 0 else np.nan  # no wire: undefined
     y_bins, top = surface.height_map(x[deposit], geom.dx, window, z_surface=0.0)
     out.update(surface.profile_metrics(y_bins, top, geom.dx))
     out["profile"] = (y_bins, top)
