@@ -296,8 +296,8 @@ def speed_accuracy_table(ds: xr.Dataset, exp: pd.DataFrame, reference: str | Non
     return df
 
 
-def model_check_table(ds: xr.Dataset, metrics=("bead_width_mm", "bead_height_mm", "pool_length_mm",
-                                              "pool_depth_mm")) -> pd.DataFrame:
+def model_check_table(ds: xr.Dataset, metrics=("bead_width_mm", "bead_height_mm", "pool_width_mm",
+                                              "pool_length_mm", "pool_depth_mm")) -> pd.DataFrame:
     """SPH checks of the reduced model: each SPH run beside the reduced run of the same scene.
 
     The same scene: equal values of every parameter the reduced model reads, except ``model`` and
