@@ -97,3 +97,12 @@ def test_more_power_wider_bead():
     p = defaults()
     widths = [run_reduced({**p, "beam_power_W": P}, TI)["pool_width_mm"] for P in (600, 900, 1200)]
     assert widths[0] < widths[1] < widths[2]
+
+
+def test_beam_only_pass_has_no_bead_and_no_mass_balance():
+    p = {**defaults(), "wire_feed_mm_s": 0.0}
+    r = run_reduced(p, TI)
+    assert r["bead_area_mm2"] == 0.0 and r["bead_width_mm"] == 0.0 and r["wire_melt_power_W"] == 0.0
+    assert math.isnan(r["mass_balance_ratio"])
+    # the whole absorbed power heats the plate: a wider pool than with the wire's melting power taken out
+    assert r["pool_width_mm"] > run_reduced(defaults(), TI)["pool_width_mm"] > 0

@@ -340,7 +340,7 @@ def run_reduced(params: dict, material: Material) -> dict:
         "pool_volume_mm3": pool.volume / mm**3,
         "T_max_K": pool.T_peak,
         "wire_supply_area_mm2": area / mm**2,
-        "mass_balance_ratio": 1.0,
+        "mass_balance_ratio": 1.0 if area > 0 else math.nan,  # no wire: undefined
         "wire_melt_power_W": p_wire,
         "absorbed_power_W": absorbed,
         "wall_time_s": time.perf_counter() - t_start,
