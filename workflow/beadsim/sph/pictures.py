@@ -120,13 +120,18 @@ def bead_pictures(snap: dict, dx: float, T_melt: float, x_cut: float | None = No
     return fig
 
 
-def latest_dump(folder: str | Path) -> Path | None:
-    """The ``*.lammpstrj`` with the largest step number in its name, or None."""
+def dumps_by_step(folder: str | Path) -> list[Path]:
+    """The ``*.lammpstrj`` files of a folder in the order of the step number in their names."""
     def step(p: Path) -> int:
         digits = re.findall(r"\d+", p.stem)
         return int(digits[-1]) if digits else -1
 
-    dumps = sorted(Path(folder).glob("*.lammpstrj"), key=step)
+    return sorted(Path(folder).glob("*.lammpstrj"), key=step)
+
+
+def latest_dump(folder: str | Path) -> Path | None:
+    """The ``*.lammpstrj`` with the largest step number in its name, or None."""
+    dumps = dumps_by_step(folder)
     return dumps[-1] if dumps else None
 
 

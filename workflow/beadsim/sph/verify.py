@@ -562,7 +562,6 @@ def moving_ring_conduction(
         ``mass_balance_ratio`` (NaN: no wire), ``n_wire_particles`` (in the last dumps), ``n_particles``,
         ``wall_time_s``.
     """
-    import glob
     import math
     import tempfile
     from pathlib import Path
@@ -571,6 +570,7 @@ def moving_ring_conduction(
     from beadsim.parameters import defaults
     from beadsim.sph import surface
     from beadsim.sph.driver import run_case
+    from beadsim.sph.pictures import dumps_by_step, read_dump
     from beadsim.sph.scene import TYPE_WIRE
 
     mat = get_material(material)
@@ -585,13 +585,13 @@ def moving_ring_conduction(
     t0 = time.perf_counter()
     metrics = run_case(params, out, material=unmeltable)
     wall = time.perf_counter() - t0
-    dumps = sorted(glob.glob(str(out / "dumps" / "dump.*.lammpstrj")), key=lambda s: int(s.split(".")[-2]))
     dx = dx_mm * 1e-3
     widths, lengths, n_wire = [], [], 0
-    for path in dumps[-3:]:
-        rows = np.loadtxt(path, skiprows=9)  # id type x y z vx vy vz c_rho c_e c_T
-        n_wire = max(n_wire, int((rows[:, 1] == TYPE_WIRE).sum()))
-        ext = surface.isotherm_extent(rows[:, 2:5], rows[:, 10], mat.T_melt, dx)
+    for path in dumps_by_step(out / "dumps")[-3:]:
+        snap = read_dump(path)
+        n_wire = max(n_wire, int((snap["type"] == TYPE_WIRE).sum()))
+        pos = np.column_stack([snap["x"], snap["y"], snap["z"]])
+        ext = surface.isotherm_extent(pos, snap["c_T"], mat.T_melt, dx)
         widths.append(ext["width_mm"])
         lengths.append(ext["length_mm"])
     mm = 1e-3
