@@ -40,14 +40,23 @@ Measured with these scenes (Ti-Gr2, h = 2.5 dx unless said):
 
 from __future__ import annotations
 
+import math
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.special import erfc
 
+from beadsim import reduced
 from beadsim.lammps_env import new_lammps
 from beadsim.materials import get_material
+from beadsim.parameters import defaults
+from beadsim.sph import surface
+from beadsim.sph.driver import run_case
+from beadsim.sph.pictures import dumps_by_step, read_dump
+from beadsim.sph.scene import TYPE_WIRE
 
 
 def cubic_lattice(n: tuple[int, int, int], dx: float, origin=(0.0, 0.0, 0.0)) -> np.ndarray:
@@ -562,17 +571,6 @@ def moving_ring_conduction(
         ``mass_balance_ratio`` (NaN: no wire), ``n_wire_particles`` (in the last dumps), ``n_particles``,
         ``wall_time_s``.
     """
-    import math
-    import tempfile
-    from pathlib import Path
-
-    from beadsim import reduced
-    from beadsim.parameters import defaults
-    from beadsim.sph import surface
-    from beadsim.sph.driver import run_case
-    from beadsim.sph.pictures import dumps_by_step, read_dump
-    from beadsim.sph.scene import TYPE_WIRE
-
     mat = get_material(material)
     params = defaults()
     params.update(model="sph", material=material, resolution_mm=dx_mm, beam_power_W=power_W,
