@@ -79,6 +79,7 @@ class Numerics:
     limits : the individual time-step limits (s) before ``dt_factor``
     expected_speed : largest melt speed the scene is expected to reach (m/s)
     tait_rho0 : reference density of the Tait equation (kg/m^3): rho, or lower with surface tension
+    solid_tait_rho0 : that of the solid particle types (``wetting_pressure_balance``; else tait_rho0)
     cohesion : the :class:`beadsim.sph.tension.CohesionModel` when surface tension is on, else None
     """
 
@@ -90,6 +91,7 @@ class Numerics:
     limits: dict
     expected_speed: float
     tait_rho0: float
+    solid_tait_rho0: float
     cohesion: object = None
 
 
@@ -112,22 +114,31 @@ def choose_numerics(params: dict, mat: Material, geom: SceneGeometry) -> Numeric
     v_exp = max(geom.substrate_speed, geom.wire_feed, fall)
     c0 = params["sound_speed_m_s"] or max(10 * v_exp, math.sqrt(GRAVITY * -geom.z_lo / DENSITY_MARGIN))
     angle = params.get("wetting_angle_deg") or mat.contact_angle_deg
-    cohesion = cohesion_model(mat, dx, h, angle) if params["surface_tension"] else None
+    cohesion = (cohesion_model(mat, dx, h, angle, params["wetting_pressure_balance"])
+                if params["surface_tension"] else None)
     if cohesion is not None and not params["sound_speed_m_s"]:
         c0 = max(c0, cohesion.min_sound_speed(mat))
     nu = mat.nu if params["viscosity_model"] == "morris" else params["artificial_viscosity"] * c0 * h / 8
     limits = {"acoustic": 0.1 * h / c0, "viscous": 0.125 * h * h / max(nu, 1e-30),
               "thermal": 0.1 * dx * dx / (mat.diffusivity * params["melt_conductivity_factor"]),
               "gravity": 0.25 * math.sqrt(h / GRAVITY)}
-    tait_rho0 = mat.rho
+    tait_rho0 = solid_tait_rho0 = mat.rho
     if cohesion is not None:
         limits["capillary"] = cohesion.dt_limit(mat, dx, c0, params["artificial_viscosity"])
         if params["viscosity_model"] == "morris" or params["artificial_viscosity"] < 0.2:
             log.warning("surface tension held in drop tests only with artificial viscosity >= 0.2 (tension.py)")
-        tait_rho0 = cohesion.tait_rho0(mat, c0)
+        tait_rho0 = solid_tait_rho0 = cohesion.tait_rho0(mat, c0)
+        if params["wetting_pressure_balance"]:
+            solid_tait_rho0 = cohesion.solid_tait_rho0(mat, c0)
+        elif cohesion.wetting_ratio < 1 - 1e-9:
+            # measured (mode 1, dx 0.4, efficiency 0.53, lattice wire, freeze): ratio 0.9 (79 deg) gave a bead
+            # whose melt expanded (kernel fill 0.72-0.75 against 0.98-0.99 at 1.0; height-map area 1.6x its
+            # metal's); wetting_pressure_balance removes the cause (tension.CohesionModel.solid_tait_rho0)
+            log.warning("wetting ratio %.2f < 1: the melt next to solid is cohered less than the shifted Tait "
+                        "pressure needs and expands; set wetting_pressure_balance", cohesion.wetting_ratio)
     dt = params["dt_factor"] * min(limits.values())
     return Numerics(dx=dx, h=h, mass=mat.rho * dx ** 3, c0=c0, dt=dt, limits=limits, expected_speed=v_exp,
-                    tait_rho0=tait_rho0, cohesion=cohesion)
+                    tait_rho0=tait_rho0, solid_tait_rho0=solid_tait_rho0, cohesion=cohesion)
 
 
 def fluid_pair_types(fluid_pairs_only: bool) -> list[tuple[str, str, bool]]:
@@ -154,26 +165,22 @@ def fluid_pair_types(fluid_pairs_only: bool) -> list[tuple[str, str, bool]]:
             for i in range(1, scene.N_TYPES + 1) for j in range(i, scene.N_TYPES + 1)]
 
 
-def cohesion_model(mat: Material, dx: float, h: float, angle_deg: float):
+def cohesion_model(mat: Material, dx: float, h: float, angle_deg: float, balanced: bool = False):
     """Surface-tension model of :mod:`beadsim.sph.tension` for the material's sigma and a contact angle (degree).
 
-    The angle is clamped to the calibrated range of ``tension.CONTACT_ANGLE_TABLE`` (with a warning).
+    The angle is clamped to the calibrated range of ``tension.CONTACT_ANGLE_TABLE`` (with ``balanced``, the
+    wetting pressure balance: ``tension.CONTACT_ANGLE_TABLE_BALANCED``), with a warning.
     """
     from beadsim.sph import tension
 
-    angles = [a for _, a in tension.CONTACT_ANGLE_TABLE]
+    table = tension.CONTACT_ANGLE_TABLE_BALANCED if balanced else tension.CONTACT_ANGLE_TABLE
+    angles = [a for _, a in table]
     used = min(max(angle_deg, min(angles)), max(angles))
     if used != angle_deg:
         log.warning("contact angle %.0f deg is outside the calibrated %.0f-%.0f deg; using %.0f deg",
                     angle_deg, min(angles), max(angles), used)
-    model = tension.CohesionModel.from_material(mat, dx, h=h, contact_angle_deg=used)
-    if model.wetting_ratio < 1 - 1e-9:
-        # measured (mode 1, dx 0.4, efficiency 0.53, lattice wire, freeze): ratio 0.9 (79 deg) gave a bead whose
-        # melt expanded (kernel fill 0.72-0.75 against 0.98-0.99 at 1.0; height-map area 1.6x its metal's)
-        log.warning("wetting ratio %.2f < 1 (contact angle %.0f deg): the melt next to solid is cohered less "
-                    "than the shifted Tait pressure needs, and bead melt expanded in a test run (see tension.py)",
-                    model.wetting_ratio, used)
-    return model
+    return tension.CohesionModel.from_material(mat, dx, h=h,
+                                               wetting_ratio=tension.wetting_ratio_for_angle(used, table))
 
 
 # ----------------------------------------------------------------------------------------------- helpers
@@ -587,15 +594,21 @@ class BeadRun:
 
     def _pair_setup(self) -> tuple[list[str], list[str]]:
         """Pair sub-styles and pair_coeff lines; surface tension plugs in as one more overlay sub-style."""
-        rho0, c0, h = self.num.tait_rho0, self.num.c0, self.num.h
+        c0, h = self.num.c0, self.num.h
         if self.p["viscosity_model"] == "morris":
             styles = ["sph/taitwater/morris"]
-            args = f"sph/taitwater/morris {rho0:.9g} {c0:.9g} {self.mat.mu:.9g}"
+            tail = f"{c0:.9g} {self.mat.mu:.9g}"
         else:
             styles = ["sph/taitwater"]
-            args = f"sph/taitwater {rho0:.9g} {c0:.9g} {self.p['artificial_viscosity']:.9g}"
-        coeffs = [f"pair_coeff {i} {j} {args} {h if on else 0.0:.9g}"
-                  for i, j, on in fluid_pair_types(self.p["fluid_pairs_only"])]
+            tail = f"{c0:.9g} {self.p['artificial_viscosity']:.9g}"
+        pairs = fluid_pair_types(self.p["fluid_pairs_only"])
+        if self.num.solid_tait_rho0 != self.num.tait_rho0 and pairs[0][0] == "*":  # per-type reference densities
+            n = scene.N_TYPES
+            pairs = [(str(i), str(j), True) for i in range(1, n + 1) for j in range(i, n + 1)]
+        # the style takes each type's Tait reference density from the pair_coeff lines whose first type it is
+        coeffs = [f"pair_coeff {i} {j} {styles[0]} "
+                  f"{self.num.tait_rho0 if i == '*' or int(i) in FLUID_TYPES else self.num.solid_tait_rho0:.9g} "
+                  f"{tail} {h if on else 0.0:.9g}" for i, j, on in pairs]
         styles.append("sph/heatconduction")
         coeffs.append(f"pair_coeff * * sph/heatconduction {self.mat.diffusivity:.9g} {h:.9g}")
         not_liquid = (TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED, TYPE_FALLING)

@@ -32,6 +32,11 @@ SPH_PARAMETERS: list[Param] = [
           long_name="fluid pairs only"),
     Param("surface_tension", "boolean", False, "", "add a pairwise cohesive (surface tension) force between "
           "liquid particles (beadsim.sph.tension); off in the paper", short="st", models=_SPH),
+    Param("wetting_pressure_balance", "boolean", False, "", "surface tension with a wetting ratio below 1: give "
+          "the solid particle types a Tait reference density at which their pressure balances the weaker "
+          "liquid-solid cohesion across the interface ((2 r - 1) times the liquid's background pressure; "
+          "tension.CohesionModel.solid_tait_rho0), so that the melt beside solid does not expand; no effect at "
+          "ratio 1", short="wpb", models=_SPH, long_name="wetting pressure balance"),
     Param("latent_heat", "boolean", False, "", "latent heat of fusion as an effective heat capacity over "
           "mushy_range_K above T_melt; off to match the paper", short="lh", models=_SPH),
     Param("mushy_range_K", "number", 50.0, "K", "temperature range over which the latent heat is released "

@@ -67,6 +67,9 @@ class SceneSettings:
         Neighbour skin, m; None = 0.3 dx.
     backend : str
         Cohesive backend, ``"table"``, ``"lepton"`` or ``"none"`` (no cohesion).
+    pressure_balance : bool
+        Give the solid type the Tait reference density of :meth:`CohesionModel.solid_tait_rho0` (the bead
+        driver's ``wetting_pressure_balance``) instead of the liquid's.
     """
 
     dx: float = 3.0e-4
@@ -77,6 +80,7 @@ class SceneSettings:
     chunk: int = 10
     skin: float | None = None
     backend: str = "table"
+    pressure_balance: bool = False
 
 
 def _setup(lmp, st: SceneSettings, half: tuple[float, float, float], boundary: str = "f f f"):
@@ -119,6 +123,9 @@ def _finish_setup(
     lmp.command(f"pair_style hybrid/overlay {sph} sph/heatconduction" + extra)
     rho0 = mat.rho if st.backend == "none" else model.tait_rho0(mat, st.c0)
     lmp.command(f"pair_coeff * * {sph} {rho0:.9g} {st.c0} {visc} {model.h:.9g}")
+    if st.pressure_balance and st.backend != "none":  # the style reads a type's rho0 from its pair_coeff lines
+        lmp.command(f"pair_coeff {SOLID} {SOLID} {sph} {model.solid_tait_rho0(mat, st.c0):.9g} {st.c0} {visc} "
+                    f"{model.h:.9g}")
     lmp.command(f"pair_coeff * * sph/heatconduction {mat.diffusivity:.9g} {model.h:.9g}")
     if st.backend != "none":
         others = [t for t in (LIQUID, SOLID) if t not in cohesive_types]
