@@ -39,6 +39,11 @@ angles: a one-layer film creeps out from the drop (and at 1.3 the liquid spreads
 ~65 degrees (mean) are therefore out of reach of this model at dx 0.3 mm; at ratio 1.0 the receding angle is
 52 degrees.
 
+With a ratio below 1 the solid, at the liquid's shifted Tait pressure, pushes harder across the interface than
+the weaker liquid-solid cohesion pulls: the liquid is pushed off the solid (part of the non-wetting above) and
+melt beside solid expands. :meth:`CohesionModel.solid_tait_rho0` balances the crossing pairs (the driver's
+``wetting_pressure_balance``); :data:`CONTACT_ANGLE_HYSTERESIS_BALANCED` holds the angles with it.
+
 LAMMPS plumbing
 ---------------
 The term is a sub-style of ``pair_style hybrid/overlay`` next to the SPH styles::
