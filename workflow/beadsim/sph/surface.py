@@ -39,6 +39,25 @@ def _window(pos: np.ndarray, x_window: tuple[float, float]) -> np.ndarray:
     return (pos[:, 0] >= x_window[0]) & (pos[:, 0] <= x_window[1])
 
 
+def _column_table(pos, dx, keep, stat, reducer):
+    """Per-(x, y)-column reduction of a per-particle value on lattice-aligned bins of width ``dx``.
+
+    The grid of columns is set by all particles ``pos``; only those flagged by ``keep`` (None: all) feed the
+    reduction. Returns the table (nx, ny), ``-inf`` (``np.maximum``) or ``+inf`` (``np.minimum``) where a
+    column is empty, and the x and y bin centres (m).
+    """
+    phase_x, phase_y = lattice_phase(pos[:, 0], dx), lattice_phase(pos[:, 1], dx)
+    ix, iy = bin_index(pos[:, 0], dx, phase_x), bin_index(pos[:, 1], dx, phase_y)
+    ix0, iy0 = ix.min(), iy.min()
+    fill = -np.inf if reducer is np.maximum else np.inf
+    table = np.full((ix.max() - ix0 + 1, iy.max() - iy0 + 1), fill)
+    use = np.ones(len(pos), dtype=bool) if keep is None else np.asarray(keep, dtype=bool)
+    reducer.at(table, (ix[use] - ix0, iy[use] - iy0), np.asarray(stat, dtype=float)[use])
+    x_centres = (np.arange(table.shape[0]) + ix0 + phase_x) * dx
+    y_centres = (np.arange(table.shape[1]) + iy0 + phase_y) * dx
+    return table, x_centres, y_centres
+
+
 def _column_median(pos, dx, x_window, keep, stat, reducer):
     """Median over the x columns of a window of a per-(x, y)-column reduction of a per-particle value.
 
@@ -70,15 +89,8 @@ def _column_median(pos, dx, x_window, keep, stat, reducer):
     inside = _window(pos, x_window)
     if not inside.any():
         return np.empty(0), np.empty(0)
-    grid = pos[inside]
-    phase_x, phase_y = lattice_phase(grid[:, 0], dx), lattice_phase(grid[:, 1], dx)
-    ix, iy = bin_index(grid[:, 0], dx, phase_x), bin_index(grid[:, 1], dx, phase_y)
-    ix0, iy0 = ix.min(), iy.min()
-    fill = -np.inf if reducer is np.maximum else np.inf
-    table = np.full((ix.max() - ix0 + 1, iy.max() - iy0 + 1), fill)
-    use = np.ones(len(grid), dtype=bool) if keep is None else np.asarray(keep, dtype=bool)[inside]
-    reducer.at(table, (ix[use] - ix0, iy[use] - iy0), np.asarray(stat, dtype=float)[inside][use])
-    y_centres = (np.arange(table.shape[1]) + iy0 + phase_y) * dx
+    table, _, y_centres = _column_table(pos[inside], dx, None if keep is None else np.asarray(keep)[inside],
+                                        np.asarray(stat)[inside], reducer)
     return y_centres, np.median(table, axis=0)
 
 
@@ -438,13 +450,7 @@ def isotherm_extent(pos, temp, level, dx):
     temp = np.asarray(temp, dtype=float)
     if not (temp >= level).any():
         return {"width_mm": 0.0, "length_mm": 0.0}
-    phase_x, phase_y = lattice_phase(pos[:, 0], dx), lattice_phase(pos[:, 1], dx)
-    ix, iy = bin_index(pos[:, 0], dx, phase_x), bin_index(pos[:, 1], dx, phase_y)
-    ix0, iy0 = ix.min(), iy.min()
-    table = np.full((ix.max() - ix0 + 1, iy.max() - iy0 + 1), -np.inf)
-    np.maximum.at(table, (ix - ix0, iy - iy0), temp)
-    xc = (np.arange(table.shape[0]) + ix0 + phase_x) * dx
-    yc = (np.arange(table.shape[1]) + iy0 + phase_y) * dx
+    table, xc, yc = _column_table(pos, dx, None, temp, np.maximum)
 
     def extent(lines: np.ndarray, coord: np.ndarray) -> float:
         best = 0.0
