@@ -24,6 +24,10 @@ def test_fluid_pair_types_cover_every_pair_with_melt():
     for (i, j), on in pairs.items():
         assert on == (i in FLUID_TYPES or j in FLUID_TYPES), (i, j)
     assert fluid_pair_types(False) == [("*", "*", True)]
+    # per-type coefficients (wetting pressure balance): every pair listed; with fluid_pairs_only as before
+    every = fluid_pair_types(False, per_type=True)
+    assert len(every) == N_TYPES * (N_TYPES + 1) // 2 and all(on for _, _, on in every)
+    assert fluid_pair_types(True, per_type=True) == fluid_pair_types(True)
 
 
 @pytest.mark.slow
