@@ -122,11 +122,14 @@ CONTACT_ANGLE_HYSTERESIS: tuple[tuple[float, float, float], ...] = (
     (1.0, 77.3, 52.0),
 )
 
+def _mean_angles(hysteresis) -> tuple[tuple[float, float], ...]:
+    """(wetting_ratio, mean of the advancing and receding angles) for rows (ratio, advancing, receding)."""
+    return tuple((ratio, round((adv + rec) / 2, 1)) for ratio, adv, rec in hysteresis)
+
+
 #: (wetting_ratio, contact angle in degree): the mean of the advancing and receding angles above, the
 #: estimate of the equilibrium angle used by :func:`wetting_ratio_for_angle`.
-CONTACT_ANGLE_TABLE: tuple[tuple[float, float], ...] = tuple(
-    (ratio, round((adv + rec) / 2, 1)) for ratio, adv, rec in CONTACT_ANGLE_HYSTERESIS
-)
+CONTACT_ANGLE_TABLE: tuple[tuple[float, float], ...] = _mean_angles(CONTACT_ANGLE_HYSTERESIS)
 
 #: As :data:`CONTACT_ANGLE_HYSTERESIS`, with the solid at the balancing Tait reference density
 #: (:meth:`CohesionModel.solid_tait_rho0`, the driver's ``wetting_pressure_balance``). Measured 2026-12-03 on a
@@ -143,9 +146,7 @@ CONTACT_ANGLE_HYSTERESIS_BALANCED: tuple[tuple[float, float, float], ...] = (
 )
 
 #: Mean angles of :data:`CONTACT_ANGLE_HYSTERESIS_BALANCED`.
-CONTACT_ANGLE_TABLE_BALANCED: tuple[tuple[float, float], ...] = tuple(
-    (ratio, round((adv + rec) / 2, 1)) for ratio, adv, rec in CONTACT_ANGLE_HYSTERESIS_BALANCED
-)
+CONTACT_ANGLE_TABLE_BALANCED: tuple[tuple[float, float], ...] = _mean_angles(CONTACT_ANGLE_HYSTERESIS_BALANCED)
 
 #: Repulsive core added to the force (strength in units of s, radius in units of h): A (1 - q / q_c)^2 for
 #: q < q_c. It keeps pairs apart where the Lucy kernel gradient, and so the SPH pressure force, vanishes
