@@ -104,5 +104,7 @@ def test_beam_only_pass_has_no_bead_and_no_mass_balance():
     r = run_reduced(p, TI)
     assert r["bead_area_mm2"] == 0.0 and r["bead_width_mm"] == 0.0 and r["wire_melt_power_W"] == 0.0
     assert math.isnan(r["mass_balance_ratio"])
+    assert r["regime"] == "beam_only"  # not a flat bead: there is no bead
+    assert run_reduced({**p, "beam_power_W": 50.0}, TI)["regime"] == "lack_of_fusion"
     # the whole absorbed power heats the plate: a wider pool than with the wire's melting power taken out
     assert r["pool_width_mm"] > run_reduced(defaults(), TI)["pool_width_mm"] > 0

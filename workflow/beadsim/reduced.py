@@ -34,8 +34,9 @@ from scipy import optimize, special
 
 from beadsim.materials import Material
 
-# Regimes a process engineer cares about, worst first.
-REGIMES = ("no_wire_melt", "lack_of_fusion", "burn_through", "tall_bead", "flat_bead", "ok")
+# Regimes a process engineer cares about, worst first; ``beam_only`` is a pass without wire (V_w = 0) that melts
+# the plate, which has no bead to call flat or tall.
+REGIMES = ("no_wire_melt", "lack_of_fusion", "burn_through", "tall_bead", "flat_bead", "beam_only", "ok")
 
 
 @dataclass(frozen=True)
@@ -274,14 +275,16 @@ def wire_melt_power(mat: Material, d: float, V_w: float, T0: float) -> float:
 
 
 def classify(absorbed: float, p_wire: float, pool: Pool, aspect: float, theta_deg: float,
-             thickness: float) -> str:
-    """The process regime (one of REGIMES)."""
-    if absorbed <= p_wire:
+             thickness: float, wire_fed: bool = True) -> str:
+    """The process regime (one of REGIMES); ``wire_fed`` False for a beam-only pass."""
+    if wire_fed and absorbed <= p_wire:
         return "no_wire_melt"
     if pool.width <= 0:
         return "lack_of_fusion"
     if math.isfinite(thickness) and pool.depth >= 0.999 * thickness:
         return "burn_through"
+    if not wire_fed:
+        return "beam_only"
     if theta_deg > 85 or aspect > 0.6:
         return "tall_bead"
     if theta_deg < 20 or aspect < 0.12:
@@ -326,7 +329,7 @@ def run_reduced(params: dict, material: Material) -> dict:
         width = height = theta = 0.0
     theta_deg = math.degrees(theta)
     aspect = height / width if width > 0 else 0.0
-    regime = classify(absorbed, p_wire, pool, aspect, theta_deg, src.thickness)
+    regime = classify(absorbed, p_wire, pool, aspect, theta_deg, src.thickness, wire_fed=area > 0)
     return {
         "bead_width_mm": width / mm,
         "bead_height_mm": height / mm,
