@@ -56,10 +56,10 @@ DENSITY_MARGIN = 0.01  # allowed hydrostatic density error g H / c0^2 for the au
 #: 0.01 s of process it cost ~4 % of a dx 0.4 run). Also written at every checkpoint and at the end.
 SERIES_WRITE_INTERVAL_S = 20.0
 POOL_KEYS = ("pool_length_mm", "pool_width_mm", "pool_depth_mm", "pool_volume_mm3")
-#: Per-section bead values whose spread (standard deviation over the averaged sections) is reported: a bead that
-#: humps has a steady mean only over a stretch longer than a hump.
 #: Bead sections (0.05 s apart) whose mass balance makes the moving window steady.
 STEADY_SECTIONS = 3
+#: Per-section bead values whose spread (standard deviation over the averaged sections) is reported: a bead that
+#: humps has a steady mean only over a stretch longer than a hump.
 SECTION_SPREAD = {"bead_width_mm": "bead_width_sd_mm", "bead_height_mm": "bead_height_sd_mm",
                   "mass_balance_ratio": "mass_balance_sd"}
 
