@@ -31,6 +31,8 @@ METRICS: dict[str, tuple[str, str]] = {
     "melt_speed_max_m_s": ("m s-1", "maximum melt speed"),
     "wire_supply_area_mm2": ("mm2", "wire area fed per unit travel"),
     "mass_balance_ratio": ("1", "bead area / wire supply area"),
+    "bead_packing": ("1", "bead area above the substrate / the wire metal in the same sections at the "
+                     "lattice's density (SPH; ~1 for a dense deposit, above 1 for a loose one)"),
     "wire_melt_power_W": ("W", "power needed to melt the wire"),
     "absorbed_power_W": ("W", "absorbed beam power"),
     "energy_in_J": ("J", "beam energy delivered"),

@@ -315,6 +315,59 @@ def compression_density(x_all: np.ndarray, sources: np.ndarray, dx: float, h: fl
     return box[near], rho0 * phi[near] / lattice_volume_fraction(dx, h)
 
 
+#: Mean distance to the three nearest neighbours (in dx) above which a melt particle counts as loosely packed
+#: (:func:`loose_density_ceiling`). In a dense cohesive drop (Ti sessile drop, 442 particles, dx 0.4 mm,
+#: ratio 0.8 with the pressure balance) it reads 0.84 / 0.92 / 1.07 / 1.19 dx (10 / 50 / 90 / 99 %); in the
+#: Ti beads the melt read 0.92 / 1.09 / 1.29 and the solid bead 0.99 / 1.13 / 1.30. Chosen with
+#: :data:`LOOSE_MELT_RELAX_STEPS` on sessile drops (0.06 s; height-map volume over the particles' volume,
+#: started loose at 1.2 dx / started at dx): 1.0 and 200 steps compact the loose drop to 0.98 and leave the
+#: dense one at 0.93 (0.99 without the ceiling); 1.0 and 100 steps: 0.96 / 0.92; 1.03 and 100: 1.02 / 0.94;
+#: 1.07 and 30: 1.06 / 0.97 (a neutral band between 1.0 and the threshold is left loose).
+LOOSE_MELT_D3 = 1.0
+#: Time steps over which the density of a loose melt particle relaxes to its ceiling (the excess falls by
+#: 1 - exp(-chunk_steps / this) per chunk). Capped at once, a particle's pressure drops by the full background
+#: pressure in one chunk (Ti at dx 0.4 mm: 1.6e4 m/s2 on the particle), and mode 1 stopped at 0.89 s on a melt
+#: speed of 2.3 m/s. 200 steps are 2.2 ms at dx 0.4, about five capillary times sqrt(rho dx^3 / sigma).
+LOOSE_MELT_RELAX_STEPS = 200
+
+
+def loose_density_ceiling(x_all: np.ndarray, targets: np.ndarray, dx: float, rho0: float,
+                          rho_min: float, d_ref: float = LOOSE_MELT_D3) -> np.ndarray:
+    """Largest density (kg/m^3) the local packing allows each of ``targets``: rho0 (d_ref dx / d3)^3, not
+    below ``rho_min``, with d3 the mean distance to the three nearest particles of ``x_all`` (any type).
+
+    Why: with the pairwise cohesion, the shifted Tait pressure (at the continuity density) and the cohesive
+    attraction balance at the lattice spacing in the bulk, but a liquid spread uniformly to 1.1-1.5 dx while
+    its continuity density stays at rho0 is nearly neutral (pair virial of the two together within 0.06 of
+    the background pressure from 0.9 to 1.7 dx): nothing pulls it back. Melt that was spread this way (a
+    stretched bridge from the wire, a film whose continuity density hardly changes with few neighbours) stays
+    loose; a Ti sessile drop cut from a lattice at 1.2 dx with density rho0 stayed at 1.26-1.30x its
+    particles' volume for 0.1 s. Capping the density of loose particles lowers their pressure, and the
+    cohesion compacts them (the same drop with the driver's relaxation, :data:`LOOSE_MELT_RELAX_STEPS`: 0.98x
+    after 0.06 s; a drop cut at dx reads 0.93x with the ceiling, 0.99x without). The nearest-neighbour
+    distance, unlike the kernel sum, does not fall at a free surface.
+
+    Parameters
+    ----------
+    x_all : (N, 3) positions of every particle that can be a neighbour (m)
+    targets : indices into ``x_all`` of the particles to cap
+    dx : lattice spacing (m)
+    rho0 : reference density (kg/m^3)
+    rho_min : lowest ceiling (kg/m^3); the liquid's Tait reference density keeps the pressure at or above zero
+    d_ref : threshold of d3 in units of dx
+
+    Returns
+    -------
+    ceiling : (len(targets),) array (kg/m^3); rho0 or more where d3 <= d_ref dx
+    """
+    if len(targets) == 0:
+        return np.zeros(0)
+    dist, _ = cKDTree(x_all).query(x_all[targets], k=4)
+    d3 = dist[:, 1:].mean(axis=1)  # inf where fewer than three neighbours exist
+    with np.errstate(divide="ignore"):
+        return np.maximum(rho0 * (d_ref * dx / d3) ** 3, rho_min)
+
+
 # ----------------------------------------------------------------------------------------------- beam
 
 def beam_weights(params: dict, cx: np.ndarray, cy: np.ndarray, beam_x: float, t0: float, t1: float) -> np.ndarray:
@@ -510,7 +563,12 @@ class BeadRun:
         self.chunk = int(params["chunk_steps"])
         self.t0_wall = time.perf_counter()
         self.T0 = params["preheat_K"]
-        self.speed_limit = params["speed_limit_m_s"] or 0.5 * self.num.c0
+        # half the liquid's sound speed: c0, or with surface tension that of the shifted Tait liquid at rho,
+        # c0 (rho / rho0')^3 (1.84 c0 for Ti at dx 0.4 mm), which the dense Ti melt on the wire tip reaches
+        # transiently at 2.2-2.3 m/s against c0 / 2 = 2.08 m/s (mode 1 with loose_melt_ceiling, 0.65-0.89 s)
+        c_liquid = (self.num.c0 if self.num.cohesion is None
+                    else self.num.cohesion.effective_sound_speed(self.mat, self.num.c0))
+        self.speed_limit = params["speed_limit_m_s"] or 0.5 * c_liquid
         # The Shepard filter holds the density of a cohesive liquid at rho0 while it expands under the positive
         # background pressure of the shifted Tait equation (tension.py): mode 1 with surface tension at dx 0.4,
         # 0.3 s, the melt's kernel fill (liquid_packing) was 0.75 with the filter and 0.93 without, and over 2 s
@@ -518,6 +576,10 @@ class BeadRun:
         # cohesion model run without it.
         self.shepard = bool(params["shepard_interval"]) and self.num.cohesion is None
         self.liquid_packing_local = np.zeros(0)  # kernel fill / lattice of this rank's melt, last chunk
+        # loose_melt_ceiling acts on the cohesive melt only: without cohesion the Tait reference density is
+        # rho0 and a loose liquid's pressure already falls with its continuity density
+        self.loose_ceiling = bool(params["loose_melt_ceiling"]) and self.num.cohesion is not None
+        self.loose_capped_local = 0  # this rank's liquid particles capped in the last chunk
 
     # ---- setup
     def open(self, resume: bool) -> None:
@@ -673,7 +735,8 @@ class BeadRun:
         n = self.num
         lim = ", ".join(f"{k} {v:.3g} s" for k, v in n.limits.items())
         msg = (f"dx {n.dx * 1e3:.3g} mm, h {n.h * 1e3:.3g} mm, c0 {n.c0:.3g} m/s (expected melt speed "
-               f"{n.expected_speed:.3g} m/s), limits: {lim}; dt = {self.p['dt_factor']:.3g} x min = {n.dt:.3g} s; "
+               f"{n.expected_speed:.3g} m/s, watchdog limit {self.speed_limit:.3g} m/s), limits: {lim}; "
+               f"dt = {self.p['dt_factor']:.3g} x min = {n.dt:.3g} s; "
                f"block {self.geom.x_hi - self.geom.x_lo:.4g} x {self.geom.y_hi - self.geom.y_lo:.4g} x "
                f"{-self.geom.z_lo:.4g} m, cut faces {self.geom.cut_faces}, {self.lmp.get_natoms()} particles")
         nominal = math.pi * self.geom.wire_radius ** 2
@@ -683,6 +746,11 @@ class BeadRun:
                 f"{nominal * 1e6:.3g} mm2, slices {pitch * 1e3:.3g} mm apart")
         if self.p["shepard_interval"] and not self.shepard:
             msg += "; no Shepard filter with surface tension (it lets the cohesive liquid expand)"
+        if self.loose_ceiling:
+            msg += (f"; loose melt (3 nearest particles more than {LOOSE_MELT_D3:g} dx away on average) "
+                    f"relaxes to its density ceiling over {LOOSE_MELT_RELAX_STEPS} steps")
+        elif self.p["loose_melt_ceiling"]:
+            msg += "; loose_melt_ceiling has no effect without surface tension"
         log.info(msg)
         self.deck.note(msg)
         stretch = pitch / n.dx
@@ -1002,6 +1070,22 @@ class BeadRun:
         rho = self._rho()
         rho[targets] = np.maximum(rho[targets], np.minimum(floor, cap))
 
+    def _loose_melt_ceiling(self) -> None:
+        """Relax the density of this rank's loosely packed liquid particles towards their ceiling
+        (:func:`loose_density_ceiling` over own and ghost particles, whose reach, h + skin beyond the rank, is
+        more than three neighbour distances; relaxation time :data:`LOOSE_MELT_RELAX_STEPS`)."""
+        nlocal = self._nlocal()
+        liquid = np.flatnonzero(self._types() == TYPE_LIQUID)
+        if len(liquid) == 0:
+            return
+        nall = nlocal + self.lmp.extract_setting("nghost")
+        x = self.lmp.numpy.extract_atom("x", nelem=nall, dim=3)
+        ceiling = loose_density_ceiling(x, liquid, self.num.dx, self.mat.rho, self.num.tait_rho0)
+        rho = self._rho()
+        excess = np.maximum(rho[liquid] - ceiling, 0.0)
+        self.loose_capped_local = int((excess > 0).sum())
+        rho[liquid] -= excess * (1.0 - math.exp(-self.chunk / LOOSE_MELT_RELAX_STEPS))
+
     def _liquid_packing(self) -> float:
         """Kernel fill of the melt: the 90th percentile over the molten particles of sum_j dx^3 W_ij over the
         lattice's (:func:`compression_density` / rho0, last chunk). About 1 in a pool inside the solid packed
@@ -1216,6 +1300,8 @@ class BeadRun:
                 self._shepard(np.isin(self._types(), FLUID_TYPES))
                 st.steps_since_shepard = 0
             self._compression_floor()
+            if self.loose_ceiling:
+                self._loose_melt_ceiling()
             self._cap_temperature()
             self._boundary_flux(temp, dt_chunk)
             m = self._measure(self.thermal.temperature(self._e()))
@@ -1438,6 +1524,9 @@ class BeadRun:
                     out["aspect_ratio"] = out["bead_height_mm"] / out["bead_width_mm"]
                 log.info("bead: mean profile of the sections at t = %s s", ", ".join(f"{c['t']:.3f}" for c in checks))
             out.pop("profile", None)
+            metal = out.get("mass_balance_ratio", np.nan) * out["wire_supply_area_mm2"]
+            if np.isfinite(metal) and metal > 0:
+                out["bead_packing"] = out.get("bead_area_mm2", np.nan) / metal
         return out
 
     def _pool_means(self, window: float = 0.25) -> dict:

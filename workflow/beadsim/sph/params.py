@@ -107,6 +107,11 @@ SPH_PARAMETERS: list[Param] = [
           "last froze, so that melt which expanded before freezing remelts at its own density instead of "
           "being refilled to rho0 at every freeze-melt cycle)", enum=("rho0", "freeze"), short="rsd",
           models=_SPH),
+    Param("loose_melt_ceiling", "boolean", False, "", "surface tension: cap the density of loosely packed "
+          "melt (mean distance to its three nearest particles above dx) at what its packing allows, so that "
+          "the cohesion compacts it (driver.loose_density_ceiling); without it melt spread at ~1.2 dx with its "
+          "continuity density at rho0 feels no restoring force and the bead stays loose", short="lmc",
+          models=_SPH, long_name="loose-melt density ceiling"),
     Param("stop_at_steady_state", "boolean", False, "", "stop before sim_time_s once the melt count and pool "
           "length (and, in the window domain, the bead width and height) are steady within steady_tolerance",
           short="ss", models=_SPH),
@@ -122,7 +127,8 @@ SPH_PARAMETERS: list[Param] = [
     Param("density_tolerance", "number", 0.2, "1", "watchdog: fail when the liquid density leaves "
           "[1 - tol, 1 + tol] rho0", exclusive_minimum=0, maximum=1, short="rtol", models=_SPH),
     Param("speed_limit_m_s", "number", 0.0, "m s-1", "watchdog: fail above this particle speed; 0 = half the "
-          "sound speed", minimum=0, maximum=1000, short="vlim", models=_SPH),
+          "liquid's sound speed (c0; with surface tension that of the shifted Tait liquid, c0 (rho / rho0')^3)",
+          minimum=0, maximum=1000, short="vlim", models=_SPH),
     Param("spatter_limit", "integer", 10, "1", "watchdog: fluid particles that may leave the modelled block "
           "(droplets skating off over the cold substrate; deleted, their energy kept in the ledger) before the "
           "run fails", minimum=0, maximum=100000, short="splim", models=_SPH, long_name="spatter limit"),

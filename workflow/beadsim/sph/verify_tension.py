@@ -40,6 +40,8 @@ from scipy.spatial import cKDTree
 
 from beadsim.lammps_env import new_lammps
 from beadsim.materials import Material, get_material
+from beadsim.sph.driver import LOOSE_MELT_RELAX_STEPS, loose_density_ceiling
+from beadsim.sph.surface import _column_table
 from beadsim.sph.tension import CohesionModel
 
 LIQUID, SOLID = 1, 2
@@ -70,6 +72,9 @@ class SceneSettings:
     pressure_balance : bool
         Give the solid type the Tait reference density of :meth:`CohesionModel.solid_tait_rho0` (the bead
         driver's ``wetting_pressure_balance``) instead of the liquid's.
+    loose_ceiling : bool
+        Relax the density of loosely packed liquid towards its ceiling every chunk, as the bead driver's
+        ``loose_melt_ceiling`` does (:func:`beadsim.sph.driver.loose_density_ceiling`).
     """
 
     dx: float = 3.0e-4
@@ -81,6 +86,7 @@ class SceneSettings:
     skin: float | None = None
     backend: str = "table"
     pressure_balance: bool = False
+    loose_ceiling: bool = False
 
 
 def _setup(lmp, st: SceneSettings, half: tuple[float, float, float], boundary: str = "f f f"):
@@ -145,8 +151,11 @@ def _local(lmp, name: str) -> np.ndarray:
     return lmp.numpy.extract_atom(name)[: lmp.extract_global("nlocal")]
 
 
-def _run_chunks(lmp, nsteps: int, st: SceneSettings, rho0: float, history_every: int = 0) -> dict:
-    """Run ``nsteps`` in chunks, resetting solid velocity and density between chunks.
+def _run_chunks(lmp, nsteps: int, st: SceneSettings, rho0: float, history_every: int = 0,
+                loose_rho_min: float | None = None) -> dict:
+    """Run ``nsteps`` in chunks, resetting solid velocity and density between chunks (and, with
+    ``st.loose_ceiling``, capping the density of loose liquid, not below ``loose_rho_min``: the liquid's Tait
+    reference density).
 
     Returns wall time, particle-steps per second, the largest liquid speed and density range over the run and
     at its end (``*_final``); with ``history_every`` > 0 chunks also ``history``: rows (step, vmax, rho_min,
@@ -166,6 +175,13 @@ def _run_chunks(lmp, nsteps: int, st: SceneSettings, rho0: float, history_every:
         rho = _local(lmp, "rho")
         v[solid] = 0.0
         rho[solid] = rho0
+        if st.loose_ceiling:
+            if loose_rho_min is None:
+                raise ValueError("loose_ceiling needs loose_rho_min (the liquid's Tait reference density)")
+            idx = np.flatnonzero(liq)
+            ceiling = loose_density_ceiling(_local(lmp, "x"), idx, st.dx, rho0, loose_rho_min)
+            relax = 1.0 - math.exp(-st.chunk / LOOSE_MELT_RELAX_STEPS)
+            rho[idx] -= np.maximum(rho[idx] - ceiling, 0.0) * relax
         v_now = float(np.sqrt((v[liq] ** 2).sum(axis=1)).max())
         lo, hi = float(rho[liq].min()) / rho0, float(rho[liq].max()) / rho0
         vmax, rho_lo, rho_hi = max(vmax, v_now), min(rho_lo, lo), max(rho_hi, hi)
@@ -203,7 +219,7 @@ def _liquid_state(lmp, mat: Material, model: CohesionModel, st: SceneSettings, n
     lmp.command("compute vir all stress/atom NULL virial")
     lmp.command("compute rhoa all sph/rho/atom")
     lmp.command(f"fix avg all ave/atom 1 {n_avg} {n_avg} c_vir[1] c_vir[2] c_vir[3] c_rhoa")
-    stats = _run_chunks(lmp, n_avg, st, mat.rho)
+    stats = _run_chunks(lmp, n_avg, st, mat.rho, loose_rho_min=model.tait_rho0(mat, st.c0))
     liq = _local(lmp, "type") == LIQUID
     avg = np.array(lmp.numpy.extract_fix("avg", 1, 2)[: len(liq)][liq])
     rho = avg[:, 3]
@@ -276,7 +292,8 @@ def free_drop(
         lmp.command(f"region drop sphere 0 0 0 {radius:.9g} units box")
         lmp.command(f"create_atoms {LIQUID} region drop")
         dt = _finish_setup(lmp, mat, model, st)
-        stats = _run_chunks(lmp, int(round(t_end / dt)), st, mat.rho, history_every)
+        stats = _run_chunks(lmp, int(round(t_end / dt)), st, mat.rho, history_every,
+                            loose_rho_min=model.tait_rho0(mat, st.c0))
         state = _liquid_state(lmp, mat, model, st, int(round(t_average / dt)))
         stats.update({k: v for k, v in state["stats"].items() if "_final_" in k})  # end of the averaging
     finally:
@@ -363,6 +380,7 @@ def sessile_drop(
     plate_layers: int = 4,
     gravity: float = 0.0,
     initial_angle_deg: float = 90.0,
+    initial_spacing: float = 1.0,
     t_end: float = 0.02,
     t_average: float = 1e-3,
     strength: float | None = None,
@@ -393,6 +411,8 @@ def sessile_drop(
     initial_angle_deg : float
         Contact angle of the initial spherical cap (same volume as the hemisphere of ``radius``); starting
         below the final angle measures a receding angle, above it an advancing one.
+    initial_spacing : float
+        Lattice spacing of the initial cap in units of dx (above 1: loosely packed liquid at density rho).
     t_end : float
         Relaxation time, s.
     t_average : float
@@ -412,7 +432,10 @@ def sessile_drop(
         ``angle_centroid_deg`` (from volume and centroid height), ``angle_height_deg``
         (2 atan(H / a) from the top height H and the base radius a of a cap with the drop's volume),
         ``angle_deg`` (sphere fitted to the free surface above 1.5 dx, :func:`cap_angle_from_surface`; the
-        primary measure), ``height_m``, ``base_radius_m``, ``n_liquid`` and ``n_liquid_initial`` (atoms lost
+        primary measure), ``packing_ratio`` (the volume under the drop's height map, top particle + dx/2 per
+        dx-wide column as in :func:`beadsim.sph.surface.height_map`, over n dx^3: ~0.95 for a drop packed like
+        the lattice, more for a loose one), ``height_m``, ``base_radius_m``, ``n_liquid`` and
+        ``n_liquid_initial`` (atoms lost
         through the plate or the box show as a difference), ``x_liquid_m`` (final liquid positions),
         ``wetting_ratio`` and the run statistics.
     """
@@ -437,12 +460,15 @@ def sessile_drop(
         lmp.command(f"region cap sphere 0 0 {-cap_r * c:.9g} {cap_r:.9g} side in units box")
         lmp.command("region upper block INF INF INF INF 0 INF units box")
         lmp.command("region hemi intersect 2 cap upper")
+        if initial_spacing != 1.0:
+            lmp.command(f"lattice sc {initial_spacing * dx:.6g} origin 0 0 0.5")
         lmp.command(f"create_atoms {LIQUID} region hemi")
         dt = _finish_setup(lmp, mat, model, st)
         n_initial = int((_local(lmp, "type") == LIQUID).sum())
         if gravity:
             lmp.command(f"fix grav liquid gravity {gravity} vector 0 0 -1")
-        stats = _run_chunks(lmp, int(round(t_end / dt)), st, mat.rho, history_every)
+        stats = _run_chunks(lmp, int(round(t_end / dt)), st, mat.rho, history_every,
+                            loose_rho_min=model.tait_rho0(mat, st.c0))
         state = _liquid_state(lmp, mat, model, st, int(round(t_average / dt)))
         stats.update({k: v for k, v in state["stats"].items() if "_final_" in k})  # end of the averaging
     finally:
@@ -453,12 +479,15 @@ def sessile_drop(
     height = float(x[:, 2].max()) + dx / 2
     theta_c = cap_angle_from_centroid(volume, z_c)
     theta_s, sphere_r = cap_angle_from_surface(x, dx)
+    tops, _, _ = _column_table(x, dx, None, x[:, 2] + 0.5 * dx, np.maximum)
+    packing = float(tops[np.isfinite(tops)].sum() * dx**2 / (len(x) * dx**3))
     # base radius of the cap with this volume and height: V = pi H (3 a^2 + H^2) / 6
     a2 = (6 * volume / (math.pi * height) - height**2) / 3
     base = math.sqrt(max(a2, 0.0))
     return {
         "wetting_ratio": wetting_ratio,
         "angle_deg": theta_s,
+        "packing_ratio": packing,
         "sphere_radius_m": sphere_r,
         "angle_centroid_deg": theta_c,
         "angle_height_deg": math.degrees(2 * math.atan2(height, base)),
