@@ -326,8 +326,9 @@ def compression_density(x_all: np.ndarray, sources: np.ndarray, dx: float, h: fl
 LOOSE_MELT_D3 = 1.0
 #: Time steps over which the density of a loose melt particle relaxes to its ceiling (the excess falls by
 #: 1 - exp(-chunk_steps / this) per chunk). Capped at once, a particle's pressure drops by the full background
-#: pressure in one chunk (Ti at dx 0.4 mm: 1.6e4 m/s2 on the particle), and mode 1 stopped at 0.89 s on a melt
-#: speed of 2.3 m/s. 200 steps are 2.2 ms at dx 0.4, about five capillary times sqrt(rho dx^3 / sigma).
+#: pressure in one chunk (Ti at dx 0.4 mm: 1.6e4 m/s2 on the particle). On the loose drop (see LOOSE_MELT_D3)
+#: the fastest particle reached 1.25 m/s relaxing over 30 steps (threshold 1.07 dx), 0.66 over 100 and 0.74
+#: over 200 (threshold dx); 200 steps are 2.2 ms at dx 0.4, about five capillary times sqrt(rho dx^3 / sigma).
 LOOSE_MELT_RELAX_STEPS = 200
 
 
