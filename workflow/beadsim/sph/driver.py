@@ -369,6 +369,17 @@ def loose_density_ceiling(x_all: np.ndarray, targets: np.ndarray, dx: float, rho
         return np.maximum(rho0 * (d_ref * dx / d3) ** 3, rho_min)
 
 
+def relax_loose_density(rho: np.ndarray, x_all: np.ndarray, targets: np.ndarray, dx: float, rho0: float,
+                        rho_min: float, chunk_steps: int) -> None:
+    """Move ``rho[targets]`` (in place) towards :func:`loose_density_ceiling` where above it: the excess falls
+    by 1 - exp(-chunk_steps / :data:`LOOSE_MELT_RELAX_STEPS`), once per chunk of ``chunk_steps`` steps."""
+    if len(targets) == 0:
+        return
+    ceiling = loose_density_ceiling(x_all, targets, dx, rho0, rho_min)
+    relax = 1.0 - math.exp(-chunk_steps / LOOSE_MELT_RELAX_STEPS)
+    rho[targets] -= np.maximum(rho[targets] - ceiling, 0.0) * relax
+
+
 # ----------------------------------------------------------------------------------------------- beam
 
 def beam_weights(params: dict, cx: np.ndarray, cy: np.ndarray, beam_x: float, t0: float, t1: float) -> np.ndarray:
@@ -580,7 +591,6 @@ class BeadRun:
         # loose_melt_ceiling acts on the cohesive melt only: without cohesion the Tait reference density is
         # rho0 and a loose liquid's pressure already falls with its continuity density
         self.loose_ceiling = bool(params["loose_melt_ceiling"]) and self.num.cohesion is not None
-        self.loose_capped_local = 0  # this rank's liquid particles capped in the last chunk
 
     # ---- setup
     def open(self, resume: bool) -> None:
@@ -1073,19 +1083,14 @@ class BeadRun:
 
     def _loose_melt_ceiling(self) -> None:
         """Relax the density of this rank's loosely packed liquid particles towards their ceiling
-        (:func:`loose_density_ceiling` over own and ghost particles, whose reach, h + skin beyond the rank, is
-        more than three neighbour distances; relaxation time :data:`LOOSE_MELT_RELAX_STEPS`)."""
-        nlocal = self._nlocal()
+        (:func:`relax_loose_density` over own and ghost particles, whose reach, h + skin beyond the rank, is
+        more than three neighbour distances)."""
         liquid = np.flatnonzero(self._types() == TYPE_LIQUID)
         if len(liquid) == 0:
             return
-        nall = nlocal + self.lmp.extract_setting("nghost")
+        nall = self._nlocal() + self.lmp.extract_setting("nghost")
         x = self.lmp.numpy.extract_atom("x", nelem=nall, dim=3)
-        ceiling = loose_density_ceiling(x, liquid, self.num.dx, self.mat.rho, self.num.tait_rho0)
-        rho = self._rho()
-        excess = np.maximum(rho[liquid] - ceiling, 0.0)
-        self.loose_capped_local = int((excess > 0).sum())
-        rho[liquid] -= excess * (1.0 - math.exp(-self.chunk / LOOSE_MELT_RELAX_STEPS))
+        relax_loose_density(self._rho(), x, liquid, self.num.dx, self.mat.rho, self.num.tait_rho0, self.chunk)
 
     def _liquid_packing(self) -> float:
         """Kernel fill of the melt: the 90th percentile over the molten particles of sum_j dx^3 W_ij over the

@@ -40,7 +40,7 @@ from scipy.spatial import cKDTree
 
 from beadsim.lammps_env import new_lammps
 from beadsim.materials import Material, get_material
-from beadsim.sph.driver import LOOSE_MELT_RELAX_STEPS, loose_density_ceiling
+from beadsim.sph.driver import relax_loose_density
 from beadsim.sph.surface import _column_table
 from beadsim.sph.tension import CohesionModel
 
@@ -74,7 +74,7 @@ class SceneSettings:
         driver's ``wetting_pressure_balance``) instead of the liquid's.
     loose_ceiling : bool
         Relax the density of loosely packed liquid towards its ceiling every chunk, as the bead driver's
-        ``loose_melt_ceiling`` does (:func:`beadsim.sph.driver.loose_density_ceiling`).
+        ``loose_melt_ceiling`` does (:func:`beadsim.sph.driver.relax_loose_density`).
     """
 
     dx: float = 3.0e-4
@@ -178,10 +178,8 @@ def _run_chunks(lmp, nsteps: int, st: SceneSettings, rho0: float, history_every:
         if st.loose_ceiling:
             if loose_rho_min is None:
                 raise ValueError("loose_ceiling needs loose_rho_min (the liquid's Tait reference density)")
-            idx = np.flatnonzero(liq)
-            ceiling = loose_density_ceiling(_local(lmp, "x"), idx, st.dx, rho0, loose_rho_min)
-            relax = 1.0 - math.exp(-st.chunk / LOOSE_MELT_RELAX_STEPS)
-            rho[idx] -= np.maximum(rho[idx] - ceiling, 0.0) * relax
+            relax_loose_density(rho, _local(lmp, "x"), np.flatnonzero(liq), st.dx, rho0, loose_rho_min,
+                                st.chunk)
         v_now = float(np.sqrt((v[liq] ** 2).sum(axis=1)).max())
         lo, hi = float(rho[liq].min()) / rho0, float(rho[liq].max()) / rho0
         vmax, rho_lo, rho_hi = max(vmax, v_now), min(rho_lo, lo), max(rho_hi, hi)
