@@ -321,8 +321,14 @@ def compression_density(x_all: np.ndarray, sources: np.ndarray, dx: float, h: fl
 #: Ti beads the melt read 0.92 / 1.09 / 1.29 and the solid bead 0.99 / 1.13 / 1.30. Chosen with
 #: :data:`LOOSE_MELT_RELAX_STEPS` on sessile drops (0.06 s; height-map volume over the particles' volume,
 #: started loose at 1.2 dx / started at dx): 1.0 and 200 steps compact the loose drop to 0.98 and leave the
-#: dense one at 0.93 (0.99 without the ceiling); 1.0 and 100 steps: 0.96 / 0.92; 1.03 and 100: 1.02 / 0.94;
+#: dense one at 0.93 (0.965 without the ceiling); 1.0 and 100 steps: 0.96 / 0.92; 1.03 and 100: 1.02 / 0.94;
 #: 1.07 and 30: 1.06 / 0.97 (a neutral band between 1.0 and the threshold is left loose).
+#: The smoothed form (``loose_melt_smoothing``: d3 averaged within a radius, only loose regions capped) on the
+#: same drops, 200 steps: threshold 0.985 and radius 1.5 dx give 1.00 / 0.965, the dense drop as without any
+#: ceiling (0.965, 74 deg; the first form 0.93, 72 deg); 1.0 and 1.5: 1.05 / 0.97; 1.0 and 2.0: 1.11 / 0.98;
+#: 1.0 and 1.2: 1.03 / 0.96; 0.97 and 1.5: 0.98 / 0.94 (a threshold below dx caps a lattice at rho0 times its
+#: cube; a dense liquid at the lattice's number density has d3 of about 0.92 dx). Capping compressed
+#: particles too (as the first form does) with 0.985 and 1.5: 1.01 / 0.95.
 LOOSE_MELT_D3 = 1.0
 #: Time steps over which the density of a loose melt particle relaxes to its ceiling (the excess falls by
 #: 1 - exp(-chunk_steps / this) per chunk). Capped at once, a particle's pressure drops by the full background
@@ -333,9 +339,11 @@ LOOSE_MELT_RELAX_STEPS = 200
 
 
 def loose_density_ceiling(x_all: np.ndarray, targets: np.ndarray, dx: float, rho0: float,
-                          rho_min: float, d_ref: float = LOOSE_MELT_D3) -> np.ndarray:
+                          rho_min: float, d_ref: float = LOOSE_MELT_D3, smoothing: float = 0.0) -> np.ndarray:
     """Largest density (kg/m^3) the local packing allows each of ``targets``: rho0 (d_ref dx / d3)^3, not
-    below ``rho_min``, with d3 the mean distance to the three nearest particles of ``x_all`` (any type).
+    below ``rho_min``, with d3 the mean distance to the three nearest particles of ``x_all`` (any type);
+    with ``smoothing`` > 0, d3 averaged over every particle within ``smoothing`` dx of the target (itself
+    included; each d3 clipped at 3 dx so that one stray particle does not dominate).
 
     Why: with the pairwise cohesion, the shifted Tait pressure (at the continuity density) and the cohesive
     attraction balance at the lattice spacing in the bulk, but a liquid spread uniformly to 1.1-1.5 dx while
@@ -345,7 +353,7 @@ def loose_density_ceiling(x_all: np.ndarray, targets: np.ndarray, dx: float, rho
     loose; a Ti sessile drop cut from a lattice at 1.2 dx with density rho0 stayed at 1.26-1.30x its
     particles' volume for 0.1 s. Capping the density of loose particles lowers their pressure, and the
     cohesion compacts them (the same drop with the driver's relaxation, :data:`LOOSE_MELT_RELAX_STEPS`: 0.98x
-    after 0.06 s; a drop cut at dx reads 0.93x with the ceiling, 0.99x without). The nearest-neighbour
+    after 0.06 s; a drop cut at dx reads 0.93x with the ceiling, 0.965x without). The nearest-neighbour
     distance, unlike the kernel sum, does not fall at a free surface.
 
     Parameters
@@ -356,26 +364,45 @@ def loose_density_ceiling(x_all: np.ndarray, targets: np.ndarray, dx: float, rho
     rho0 : reference density (kg/m^3)
     rho_min : lowest ceiling (kg/m^3); the liquid's Tait reference density keeps the pressure at or above zero
     d_ref : threshold of d3 in units of dx
+    smoothing : radius (in dx) of the neighbourhood over which d3 is averaged; 0 = each particle's own d3.
+        The average tells a loose region from the tail of a dense liquid's distribution (in a dense drop
+        10 % of the particles have d3 > 1.07 dx), which a single particle's d3 cannot (measured on drops:
+        see :data:`LOOSE_MELT_D3`).
 
     Returns
     -------
-    ceiling : (len(targets),) array (kg/m^3); rho0 or more where d3 <= d_ref dx
+    ceiling : (len(targets),) array (kg/m^3); where d3 <= d_ref dx, rho0 or more (``smoothing`` 0: a
+        compressed particle is capped too) or infinite (``smoothing`` > 0: only loose regions are capped)
     """
     if len(targets) == 0:
         return np.zeros(0)
-    dist, _ = cKDTree(x_all).query(x_all[targets], k=4)
-    d3 = dist[:, 1:].mean(axis=1)  # inf where fewer than three neighbours exist
+    tree = cKDTree(x_all)
+    if smoothing > 0:
+        dist, _ = tree.query(x_all, k=4)
+        d3_all = np.minimum(dist[:, 1:].mean(axis=1), 3 * dx)
+        pairs = cKDTree(x_all[targets]).sparse_distance_matrix(tree, smoothing * dx, output_type="coo_matrix")
+        # the pairs include each target with itself (distance 0)
+        d3 = (np.bincount(pairs.row, d3_all[pairs.col], len(targets))
+              / np.bincount(pairs.row, minlength=len(targets)))
+    else:
+        dist, _ = tree.query(x_all[targets], k=4)
+        d3 = dist[:, 1:].mean(axis=1)  # inf where fewer than three neighbours exist
     with np.errstate(divide="ignore"):
-        return np.maximum(rho0 * (d_ref * dx / d3) ** 3, rho_min)
+        ceiling = np.maximum(rho0 * (d_ref * dx / d3) ** 3, rho_min)
+    if smoothing > 0:
+        ceiling[d3 <= d_ref * dx] = np.inf
+    return ceiling
 
 
 def relax_loose_density(rho: np.ndarray, x_all: np.ndarray, targets: np.ndarray, dx: float, rho0: float,
-                        rho_min: float, chunk_steps: int) -> None:
-    """Move ``rho[targets]`` (in place) towards :func:`loose_density_ceiling` where above it: the excess falls
-    by 1 - exp(-chunk_steps / :data:`LOOSE_MELT_RELAX_STEPS`), once per chunk of ``chunk_steps`` steps."""
+                        rho_min: float, chunk_steps: int, d_ref: float = LOOSE_MELT_D3,
+                        smoothing: float = 0.0) -> None:
+    """Move ``rho[targets]`` (in place) towards :func:`loose_density_ceiling` (``d_ref``, ``smoothing``) where
+    above it: the excess falls by 1 - exp(-chunk_steps / :data:`LOOSE_MELT_RELAX_STEPS`), once per chunk of
+    ``chunk_steps`` steps."""
     if len(targets) == 0:
         return
-    ceiling = loose_density_ceiling(x_all, targets, dx, rho0, rho_min)
+    ceiling = loose_density_ceiling(x_all, targets, dx, rho0, rho_min, d_ref, smoothing)
     relax = 1.0 - math.exp(-chunk_steps / LOOSE_MELT_RELAX_STEPS)
     rho[targets] -= np.maximum(rho[targets] - ceiling, 0.0) * relax
 
@@ -712,7 +739,15 @@ class BeadRun:
             cmd(line)
         cmd(f"neighbor {0.2 * self.num.dx:.9g} bin")
         cmd("neigh_modify every 1 delay 0 check yes")
-        cmd("comm_modify vel yes")
+        smooth = self.p["loose_melt_smoothing"] if self.loose_ceiling else 0.0
+        if smooth > 0:
+            # the smoothed ceiling averages d3 over particles up to `smooth` dx from a melt particle, and each of
+            # those needs its three nearest neighbours (up to ~1.5 dx in loose melt): ghosts must reach that
+            # far beyond the rank, past the kernel cutoff + skin (2.7 dx by default)
+            reach = max(self.num.h, (smooth + 2.0) * self.num.dx) + 0.2 * self.num.dx
+            cmd(f"comm_modify vel yes cutoff {reach:.9g}")
+        else:
+            cmd("comm_modify vel yes")
         cmd("compute rho all sph/rho/atom")
         cmd("compute e all sph/e/atom")
         cmd("compute T all sph/t/atom")
@@ -758,8 +793,10 @@ class BeadRun:
         if self.p["shepard_interval"] and not self.shepard:
             msg += "; no Shepard filter with surface tension (it lets the cohesive liquid expand)"
         if self.loose_ceiling:
-            msg += (f"; loose melt (3 nearest particles more than {LOOSE_MELT_D3:g} dx away on average) "
-                    f"relaxes to its density ceiling over {LOOSE_MELT_RELAX_STEPS} steps")
+            smooth = self.p["loose_melt_smoothing"]
+            where = f"averaged within {smooth:g} dx, " if smooth > 0 else ""
+            msg += (f"; loose melt (3 nearest particles, {where}more than {self.p['loose_melt_d3']:g} dx away on "
+                    f"average) relaxes to its density ceiling over {LOOSE_MELT_RELAX_STEPS} steps")
         elif self.p["loose_melt_ceiling"]:
             msg += "; loose_melt_ceiling has no effect without surface tension"
         log.info(msg)
@@ -1083,14 +1120,16 @@ class BeadRun:
 
     def _loose_melt_ceiling(self) -> None:
         """Relax the density of this rank's loosely packed liquid particles towards their ceiling
-        (:func:`relax_loose_density` over own and ghost particles, whose reach, h + skin beyond the rank, is
-        more than three neighbour distances)."""
+        (:func:`relax_loose_density` over own and ghost particles, whose reach beyond the rank, h + skin, is
+        more than three neighbour distances; with ``loose_melt_smoothing`` the deck extends it by the
+        smoothing radius)."""
         liquid = np.flatnonzero(self._types() == TYPE_LIQUID)
         if len(liquid) == 0:
             return
         nall = self._nlocal() + self.lmp.extract_setting("nghost")
         x = self.lmp.numpy.extract_atom("x", nelem=nall, dim=3)
-        relax_loose_density(self._rho(), x, liquid, self.num.dx, self.mat.rho, self.num.tait_rho0, self.chunk)
+        relax_loose_density(self._rho(), x, liquid, self.num.dx, self.mat.rho, self.num.tait_rho0, self.chunk,
+                            self.p["loose_melt_d3"], self.p["loose_melt_smoothing"])
 
     def _liquid_packing(self) -> float:
         """Kernel fill of the melt: the 90th percentile over the molten particles of sum_j dx^3 W_ij over the

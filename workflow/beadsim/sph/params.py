@@ -112,6 +112,14 @@ SPH_PARAMETERS: list[Param] = [
           "the cohesion compacts it (driver.loose_density_ceiling); without it melt spread at ~1.2 dx with its "
           "continuity density at rho0 feels no restoring force and the bead stays loose", short="lmc",
           models=_SPH, long_name="loose-melt density ceiling"),
+    Param("loose_melt_d3", "number", 1.0, "1", "loose_melt_ceiling: the mean distance to the three nearest "
+          "particles (in dx) above which melt counts as loose; its ceiling is rho0 (this / d3)^3",
+          minimum=0.8, maximum=1.5, short="lmd", models=_SPH, long_name="loose-melt threshold / dx"),
+    Param("loose_melt_smoothing", "number", 0.0, "1", "loose_melt_ceiling: radius (in dx) over which that "
+          "distance is averaged before the comparison, so that a loose region is capped and the tail of a "
+          "dense liquid's distribution is not; 0 = each particle's own distance, and compressed particles are "
+          "capped at rho0 (threshold / d3)^3 too (the first form of the ceiling)", minimum=0, maximum=2,
+          short="lms", models=_SPH, long_name="loose-melt smoothing radius / dx"),
     Param("stop_at_steady_state", "boolean", False, "", "stop before sim_time_s once the melt count and pool "
           "length (and, in the window domain, the bead width and height) are steady within steady_tolerance",
           short="ss", models=_SPH),

@@ -40,7 +40,7 @@ from scipy.spatial import cKDTree
 
 from beadsim.lammps_env import new_lammps
 from beadsim.materials import Material, get_material
-from beadsim.sph.driver import relax_loose_density
+from beadsim.sph.driver import LOOSE_MELT_D3, relax_loose_density
 from beadsim.sph.surface import _column_table
 from beadsim.sph.tension import CohesionModel
 
@@ -75,6 +75,8 @@ class SceneSettings:
     loose_ceiling : bool
         Relax the density of loosely packed liquid towards its ceiling every chunk, as the bead driver's
         ``loose_melt_ceiling`` does (:func:`beadsim.sph.driver.relax_loose_density`).
+    loose_d3, loose_smoothing : float
+        The ceiling's threshold and smoothing radius in dx (``loose_melt_d3``, ``loose_melt_smoothing``).
     """
 
     dx: float = 3.0e-4
@@ -87,6 +89,8 @@ class SceneSettings:
     backend: str = "table"
     pressure_balance: bool = False
     loose_ceiling: bool = False
+    loose_d3: float = LOOSE_MELT_D3
+    loose_smoothing: float = 0.0
 
 
 def _setup(lmp, st: SceneSettings, half: tuple[float, float, float], boundary: str = "f f f"):
@@ -179,7 +183,7 @@ def _run_chunks(lmp, nsteps: int, st: SceneSettings, rho0: float, history_every:
             if loose_rho_min is None:
                 raise ValueError("loose_ceiling needs loose_rho_min (the liquid's Tait reference density)")
             relax_loose_density(rho, _local(lmp, "x"), np.flatnonzero(liq), st.dx, rho0, loose_rho_min,
-                                st.chunk)
+                                st.chunk, st.loose_d3, st.loose_smoothing)
         v_now = float(np.sqrt((v[liq] ** 2).sum(axis=1)).max())
         lo, hi = float(rho[liq].min()) / rho0, float(rho[liq].max()) / rho0
         vmax, rho_lo, rho_hi = max(vmax, v_now), min(rho_lo, lo), max(rho_hi, hi)
