@@ -624,10 +624,12 @@ class BeadRun:
         """Create the LAMMPS instance and the scene (or read the checkpoint)."""
         for sub in ("dumps", "restart"):
             (self.out / sub).mkdir(parents=True, exist_ok=True)
-        if not resume:
-            (self.out / "deck.in").unlink(missing_ok=True)
         self.lmp = new_lammps(log=self.out / ("log.lammps" if not resume else "log.resume.lammps"))
         self.rank0 = is_rank0(self.lmp)
+        if not resume and self.rank0:
+            # rank 0 alone: another rank unlinking it could remove the deck rank 0 has already opened (the
+            # ranks are not in step here; a 2-rank run was seen without its deck.in)
+            (self.out / "deck.in").unlink(missing_ok=True)
         self.deck = Deck(self.lmp, self.out / "deck.in")
         if resume:
             self._read_checkpoint()
