@@ -301,15 +301,20 @@ def test_melt_beside_solid_stays_packed_with_the_pressure_balance(tmp_path, bala
         assert np.all(late < 0.85), late
 
 
+def _lattice_block(n: int = 5) -> tuple[np.ndarray, np.ndarray]:
+    """A simple cubic block of n^3 particles dx apart, and the indices of all of them."""
+    g = np.arange(n) * DX
+    block = np.array(np.meshgrid(g, g, g, indexing="ij")).reshape(3, -1).T
+    return block, np.arange(len(block))
+
+
 def test_loose_density_ceiling_spares_the_lattice_and_caps_spread_melt():
     """The ceiling leaves every particle of a lattice block (interior, faces, edges, corners: three nearest
     at dx) at rho0 or above, and caps a lattice spread to 1.2 dx at rho0 (d_ref / 1.2)^3, not below the
     minimum."""
     from beadsim.sph.driver import LOOSE_MELT_D3, loose_density_ceiling
 
-    g = np.arange(5) * DX
-    block = np.array(np.meshgrid(g, g, g, indexing="ij")).reshape(3, -1).T
-    everyone = np.arange(len(block))
+    block, everyone = _lattice_block()
     assert np.all(loose_density_ceiling(block, everyone, DX, TI.rho, 0.8 * TI.rho) >= TI.rho * (1 - 1e-9))
     spread = loose_density_ceiling(1.2 * block, everyone, DX, TI.rho, 0.5 * TI.rho)
     assert spread == pytest.approx(TI.rho * (LOOSE_MELT_D3 / 1.2) ** 3)
@@ -328,15 +333,13 @@ def test_smoothed_ceiling_caps_loose_regions_only():
     lone particle a few spacings off the block, which averages only itself, gets the minimum."""
     from beadsim.sph.driver import loose_density_ceiling
 
-    g = np.arange(5) * DX
-    block = np.array(np.meshgrid(g, g, g, indexing="ij")).reshape(3, -1).T
-    everyone = np.arange(len(block))
+    block, everyone = _lattice_block()
     dense = loose_density_ceiling(0.95 * block, everyone, DX, TI.rho, 0.8 * TI.rho, d_ref=0.985, smoothing=1.5)
     assert np.all(np.isinf(dense))
     for s in (1.0, 1.2):
         spread = loose_density_ceiling(s * block, everyone, DX, TI.rho, 0.5 * TI.rho, d_ref=0.985, smoothing=1.5)
         assert spread == pytest.approx(TI.rho * (0.985 / s) ** 3)
-    stray = np.vstack([block, [[g[-1] + 3 * DX, 0.0, 0.0]]])
+    stray = np.vstack([block, [[block[:, 0].max() + 3 * DX, 0.0, 0.0]]])
     lone = loose_density_ceiling(stray, np.array([len(block)]), DX, TI.rho, 0.8 * TI.rho, d_ref=0.985,
                                  smoothing=1.5)
     assert lone == pytest.approx(0.8 * TI.rho)

@@ -378,11 +378,13 @@ def loose_density_ceiling(x_all: np.ndarray, targets: np.ndarray, dx: float, rho
         return np.zeros(0)
     tree = cKDTree(x_all)
     if smoothing > 0:
-        dist, _ = tree.query(x_all, k=4)
-        d3_all = np.minimum(dist[:, 1:].mean(axis=1), 3 * dx)
         pairs = cKDTree(x_all[targets]).sparse_distance_matrix(tree, smoothing * dx, output_type="coo_matrix")
-        # the pairs include each target with itself (distance 0)
-        d3 = (np.bincount(pairs.row, d3_all[pairs.col], len(targets))
+        # d3 only of the particles some target averages over (not of the whole substrate); the pairs include
+        # each target with itself (distance 0)
+        near, col = np.unique(pairs.col, return_inverse=True)
+        dist, _ = tree.query(x_all[near], k=4)
+        d3_near = np.minimum(dist[:, 1:].mean(axis=1), 3 * dx)
+        d3 = (np.bincount(pairs.row, d3_near[col], len(targets))
               / np.bincount(pairs.row, minlength=len(targets)))
     else:
         dist, _ = tree.query(x_all[targets], k=4)
@@ -739,14 +741,15 @@ class BeadRun:
         cmd("pair_style hybrid/overlay " + " ".join(styles))
         for line in coeffs:
             cmd(line)
-        cmd(f"neighbor {0.2 * self.num.dx:.9g} bin")
+        skin = 0.2 * self.num.dx
+        cmd(f"neighbor {skin:.9g} bin")
         cmd("neigh_modify every 1 delay 0 check yes")
         smooth = self.p["loose_melt_smoothing"] if self.loose_ceiling else 0.0
         if smooth > 0:
             # the smoothed ceiling averages d3 over particles up to `smooth` dx from a melt particle, and each of
             # those needs its three nearest neighbours (up to ~1.5 dx in loose melt): ghosts must reach that
             # far beyond the rank, past the kernel cutoff + skin (2.7 dx by default)
-            reach = max(self.num.h, (smooth + 2.0) * self.num.dx) + 0.2 * self.num.dx
+            reach = max(self.num.h, (smooth + 2.0) * self.num.dx) + skin
             cmd(f"comm_modify vel yes cutoff {reach:.9g}")
         else:
             cmd("comm_modify vel yes")
