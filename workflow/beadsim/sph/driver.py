@@ -555,6 +555,9 @@ class RunState:
     inflow_x: float = float("nan")
     feed_start_t: float = float("nan")  # process time the wire feed started (NaN: not yet)
     n_ejected: int = 0  # spatter particles deleted outside the block
+    wall_s: float = 0.0  # wall, LAMMPS and bead-check time up to the checkpoint (a resumed run counts on)
+    lammps_s: float = 0.0
+    bead_s: float = 0.0
 
 
 class PerId:
@@ -633,6 +636,7 @@ class BeadRun:
             # ranks are not in step here; a 2-rank run was seen without its deck.in)
             (self.out / "deck.in").unlink(missing_ok=True)
         self.deck = Deck(self.lmp, self.out / "deck.in")
+        self.resumed = resume
         if resume:
             self._read_checkpoint()
         else:
@@ -764,6 +768,11 @@ class BeadRun:
         cmd("group frozen dynamic all var frozen every 1")
         if p["resolidified_density"] == "freeze":  # after read_restart, the same ID restores the values
             cmd("fix rhofreeze all property/atom d_rhofreeze ghost no")
+            if self.resumed:
+                # LAMMPS keeps the restart file's per-atom fix data until a run initialises, and refuses
+                # create_atoms until then: the window's first new substrate layer (or a wire slice) would stop
+                # a resumed run. A zero-step run (before the dump is defined) lets it go.
+                cmd("run 0 post no")
         if self.geom.moving_window and not self.lmp.has_id("region", "behind"):
             cmd(f"region behind block INF {self.geom.x_lo:.9g} INF INF INF INF units box")
         cmd("fix integrate all sph")
@@ -1479,6 +1488,8 @@ class BeadRun:
     def checkpoint(self) -> None:
         """Write restart.bin and the Python state (each replaced atomically)."""
         rdir = self.out / "restart"
+        st = self.state
+        st.wall_s, st.lammps_s, st.bead_s = time.perf_counter() - self.t0_wall, self.lammps_time, self.bead_time
         self.deck(f"write_restart {rdir / 'restart.tmp.bin'}")
         max_t = allreduce(self.lmp, self.per_id.max_t, "max")
         if not is_rank0(self.lmp):
@@ -1508,6 +1519,9 @@ class BeadRun:
                     np.zeros(len(self.per_id.max_t), dtype=bool))
         self.series = json.loads(str(data["series"]))
         self.particle_steps = float(data["particle_steps"])
+        # wall time, throughput and time shares cover the whole run, not only the resumed part
+        self.t0_wall = time.perf_counter() - self.state.wall_s
+        self.lammps_time, self.bead_time = self.state.lammps_s, self.state.bead_s
         self.deck.note(f"resume from checkpoint at t = {self.state.t:.6g} s, step {self.state.step}")
         self.deck(f"read_restart {rdir / 'restart.bin'}")
         self.deck("group frozen delete")
