@@ -81,6 +81,27 @@ def test_small_bead_outputs(small_bead):
     assert 1 - params["density_tolerance"] < m["density_min"] <= m["density_max"] < 1 + params["density_tolerance"]
 
 
+def test_wire_tip_feeds_at_vw_and_its_melt_back_is_reported(small_bead):
+    """The unmelted wire's tip advances along its axis at V_w (the first samples, before the beam melts it), and
+    the melt-back metrics are those of the recorded tip positions; the test wire (1.2 mm) is short enough that
+    its feed end bounds the melt-back in part of the samples, which the share reports."""
+    from beadsim.sph import scene
+
+    params, m, out = small_bead
+    ts = xr.open_dataset(out / "timeseries.nc")
+    t, tip = ts.time.values, ts.wire_tip_s.values
+    pitch = scene.wire_slice_pitch(scene.build_geometry(params))
+    early = t < 0.03  # 0.6 mm of feed: the first slice is still solid
+    assert early.sum() >= 2
+    np.testing.assert_allclose(tip[early], pitch / 2 - params["wire_feed_mm_s"] * 1e-3 * t[early], atol=1e-9)
+    late = t >= params["sim_time_s"] / 2 - 1e-12
+    length = params["wire_length_mm"] * 1e-3
+    assert m["wire_meltback_mm"] == pytest.approx(np.minimum(tip[late], length).mean() * 1e3, rel=1e-9)
+    assert 0 < m["wire_meltback_mm"] < params["wire_length_mm"]
+    assert m["wire_feed_end_share"] == pytest.approx((tip[late] >= length - pitch).mean(), rel=1e-9)
+    assert 0 < m["wire_feed_end_share"] < 1
+
+
 def test_watchdog_catches_large_time_step(tmp_path):
     params = small_case(dt_factor=8.0, sim_time_s=0.2)
     with pytest.raises(SimulationFailed) as info:

@@ -57,6 +57,10 @@ METRICS: dict[str, tuple[str, str]] = {
                        "well below 1: expanded, or a melt without a kernel-wide interior)"),
     "spatter_particles": ("1", "fluid particles deleted after leaving the modelled block"),
     "wire_feed_start_s": ("s", "process time the wire feed started (NaN: never)"),
+    "wire_meltback_mm": ("mm", "mean distance the solid wire's tip melted back along its axis from the nominal "
+                         "tip (SPH; second half of the run)"),
+    "wire_feed_end_share": ("1", "share of samples (second half of the run) in which the wire melted back to the "
+                            "feed end of the modelled wire: above 0 the melt-back is bounded by wire_length_mm"),
     "wire_released_particles": ("1", "unmelted wire particles cut off from the fed wire (fell free)"),
     "wire_landed_particles": ("1", "released wire particles that landed on solid before melting"),
 }

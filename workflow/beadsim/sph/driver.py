@@ -1249,8 +1249,12 @@ class BeadRun:
         m["pool_x_max"] = allreduce(lmp, float(xl[:, 0].max()) if liquid.any() else -np.inf, "max")
         m["pool_y_abs_max"] = allreduce(lmp, float(np.abs(xl[:, 1]).max()) if liquid.any() else 0.0, "max")
         m["melt_z_min"] = allreduce(lmp, float(xl[:, 2].min()) if liquid.any() else np.inf, "min")
-        zw = x[types == TYPE_WIRE, 2]
-        m["wire_z_min"] = allreduce(lmp, float(zw.min()) if len(zw) else np.inf, "min")
+        xw = x[types == TYPE_WIRE]
+        m["wire_z_min"] = allreduce(lmp, float(xw[:, 2].min()) if len(xw) else np.inf, "min")
+        # how far the solid wire's tip has melted back along the axis from the nominal tip plane
+        g = self.geom
+        s_w = (xw - np.array([g.beam_x(st.t), 0.0, g.wire_height])) @ g.wire_axis
+        m["wire_tip_s"] = allreduce(lmp, float(s_w.min()) if len(s_w) else np.inf, "min")
         return m
 
     def _watchdog(self, m: dict, expected_atoms: int) -> None:
@@ -1393,7 +1397,12 @@ class BeadRun:
             self.series.append(m)
         self.checkpoint()
         self._write_series()
-        return self._metrics()
+        out = self._metrics()
+        if out["wire_feed_end_share"] > 0:
+            log.warning("the wire melted back to the feed end of the modelled wire in %.0f %% of the samples of the "
+                        "run's second half: the feed end bounds its melt-back; raise wire_length_mm (now %.3g mm)",
+                        100 * out["wire_feed_end_share"], p["wire_length_mm"])
+        return out
 
     def _bead_check(self) -> dict:
         """Bead cross-section now (moving window), for the steady-state test and the final average."""
@@ -1472,7 +1481,7 @@ class BeadRun:
                          for k in keys},
                         coords={"time": ("time", np.array([m["t"] for m in self.series]), {"units": "s"})})
         units = {"T_max": "K", "rho_min": "1", "rho_max": "1", "v_max": "m s-1", "steps_per_s": "s-1",
-                 "pool_x_min": "m", "pool_x_max": "m", "pool_y_abs_max": "m", "wire_z_min": "m",
+                 "pool_x_min": "m", "pool_x_max": "m", "pool_y_abs_max": "m", "wire_z_min": "m", "wire_tip_s": "m",
                  "melt_z_min": "m", "energy_error": "1", "bead_width_mm": "mm",
                  "bead_height_mm": "mm", "bead_area_mm2": "mm2", "contact_angle_deg": "degree",
                  "penetration_depth_mm": "mm", "fusion_width_mm": "mm", "pool_length_mm": "mm",
@@ -1538,6 +1547,21 @@ class BeadRun:
         order = np.argsort(ids)
         return x[order], types[order], ids[order]
 
+    def _meltback(self) -> dict:
+        """Wire melt-back over the second half of the run (samples after the feed started): the mean distance
+        (mm) the solid wire's tip sits behind the nominal tip plane along the axis, and the share of samples in
+        which at most the newest slice is left solid (the tip within one slice pitch of the feed end, where new
+        slices enter cold): there the modelled wire is too short and the feed end, not the heat balance, bounds
+        the melt-back."""
+        st, g = self.state, self.geom
+        start = max(st.feed_start_t if np.isfinite(st.feed_start_t) else np.inf, st.t / 2)
+        tips = np.array([m["wire_tip_s"] for m in self.series if "wire_tip_s" in m and m["t"] >= start - 1e-12])
+        if not len(tips):
+            return {"wire_meltback_mm": np.nan, "wire_feed_end_share": np.nan}
+        at_end = tips >= g.wire_length - scene.wire_slice_pitch(g)
+        return {"wire_meltback_mm": float(np.mean(np.minimum(tips, g.wire_length))) * 1e3,
+                "wire_feed_end_share": float(at_end.mean())}
+
     def _metrics(self, partial: bool = False) -> dict:
         p, st, num = self.p, self.state, self.num
         wall = time.perf_counter() - self.t0_wall
@@ -1559,6 +1583,7 @@ class BeadRun:
         out["wire_landed_particles"] = int(self.per_id.landed.sum())
         out["wire_feed_start_s"] = st.feed_start_t
         out["python_time_share_bead_checks"] = self.bead_time / wall if wall > 0 else np.nan
+        out.update(self._meltback())
         out["wire_melt_power_W"] = (self.mat.rho * area_w * 1e-6 * p["wire_feed_mm_s"] * 1e-3
                                     * (self.mat.cp * (self.mat.T_melt - self.T0) + self.mat.latent_heat))
         packing = [m["liquid_packing"] for m in self.series
