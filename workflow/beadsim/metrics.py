@@ -61,6 +61,10 @@ METRICS: dict[str, tuple[str, str]] = {
                          "tip (SPH; second half of the run)"),
     "wire_feed_end_share": ("1", "share of samples (second half of the run) in which the wire melted back to the "
                             "feed end of the modelled wire: above 0 the melt-back is bounded by wire_length_mm"),
+    "beam_share_solid_wire": ("1", "share of the absorbed beam energy that landed on solid wire (SPH; second "
+                              "half of the run)"),
+    "beam_share_wire_melt": ("1", "share of the absorbed beam energy that landed on melt from the wire, on the "
+                             "wire's tip or in the pool (SPH; second half of the run)"),
     "wire_released_particles": ("1", "unmelted wire particles cut off from the fed wire (fell free)"),
     "wire_landed_particles": ("1", "released wire particles that landed on solid before melting"),
 }

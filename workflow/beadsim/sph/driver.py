@@ -528,6 +528,9 @@ class Ledger:
     advected_in: float = 0.0
     advected_out: float = 0.0
     ejected: float = 0.0  # internal + kinetic + potential energy of spatter deleted outside the block
+    # where the beam energy landed (parts of ``beam``, not separate terms): solid wire, and melt from the wire
+    beam_solid_wire: float = 0.0
+    beam_wire_melt: float = 0.0
 
     def residual(self, now: float) -> float:
         """Energy present minus what the ledger says should be present (J)."""
@@ -1239,7 +1242,8 @@ class BeadRun:
         led = st.ledger
         m.update(E_beam=led.beam, E_volumetric=led.volumetric, E_wire_in=led.wire_in,
                  E_evaporated=led.evaporated, E_boundary=led.boundary, E_advected_in=led.advected_in,
-                 E_advected_out=led.advected_out, E_ejected=led.ejected)
+                 E_advected_out=led.advected_out, E_ejected=led.ejected, E_beam_solid_wire=led.beam_solid_wire,
+                 E_beam_wire_melt=led.beam_wire_melt)
         now = m["E_internal"] + m["E_kinetic"] + m["E_potential"] + m.get("E_cohesion", 0.0)
         m["E_residual"] = led.residual(now)
         e_in = led.beam + led.volumetric
@@ -1340,8 +1344,11 @@ class BeadRun:
             need_setup |= self._advect_window()
             need_setup |= self._remove_spatter()
             bx = self.geom.beam_x(st.t)
+            e = self._e()
+            e_before = e.copy()
             st.ledger.beam += deposit_beam(
-                self.lmp, p, self.geom, self._x(), self._e(), power * dt_chunk, bx, st.t, st.t + dt_chunk)
+                self.lmp, p, self.geom, self._x(), e, power * dt_chunk, bx, st.t, st.t + dt_chunk)
+            self._book_beam_targets(e - e_before)
             self._volumetric_heat(dt_chunk)
             natoms = int(self.lmp.get_natoms())
             t_lmp = time.perf_counter()
@@ -1547,6 +1554,25 @@ class BeadRun:
         order = np.argsort(ids)
         return x[order], types[order], ids[order]
 
+    def _book_beam_targets(self, added: np.ndarray) -> None:
+        """Add the beam energy that landed on solid wire and on melt from the wire to the ledger's sub-accounts."""
+        types = self._types()
+        from_wire = self.per_id.wire_origin[self._ids()]
+        melt = np.isin(types, FLUID_TYPES) & from_wire
+        sums = allreduce(self.lmp, np.array([added[types == TYPE_WIRE].sum(), added[melt].sum()]), "sum")
+        self.state.ledger.beam_solid_wire += float(sums[0])
+        self.state.ledger.beam_wire_melt += float(sums[1])
+
+    def _beam_shares(self) -> dict:
+        """Shares of the beam energy absorbed in the run's second half that landed on the solid wire and on melt
+        from the wire (to set beside wire_melt_power_W / absorbed_power_W, the share melting the feed needs)."""
+        half = [m for m in self.series if "E_beam_solid_wire" in m and m["t"] >= self.state.t / 2 - 1e-12]
+        if len(half) < 2 or half[-1]["E_beam"] <= half[0]["E_beam"]:
+            return {"beam_share_solid_wire": np.nan, "beam_share_wire_melt": np.nan}
+        d_beam = half[-1]["E_beam"] - half[0]["E_beam"]
+        return {"beam_share_solid_wire": (half[-1]["E_beam_solid_wire"] - half[0]["E_beam_solid_wire"]) / d_beam,
+                "beam_share_wire_melt": (half[-1]["E_beam_wire_melt"] - half[0]["E_beam_wire_melt"]) / d_beam}
+
     def _meltback(self) -> dict:
         """Wire melt-back over the second half of the run (samples after the feed started): the mean distance
         (mm) the solid wire's tip sits behind the nominal tip plane along the axis, and the share of samples in
@@ -1584,6 +1610,7 @@ class BeadRun:
         out["wire_feed_start_s"] = st.feed_start_t
         out["python_time_share_bead_checks"] = self.bead_time / wall if wall > 0 else np.nan
         out.update(self._meltback())
+        out.update(self._beam_shares())
         out["wire_melt_power_W"] = (self.mat.rho * area_w * 1e-6 * p["wire_feed_mm_s"] * 1e-3
                                     * (self.mat.cp * (self.mat.T_melt - self.T0) + self.mat.latent_heat))
         packing = [m["liquid_packing"] for m in self.series
