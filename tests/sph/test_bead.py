@@ -163,6 +163,43 @@ def test_beam_lands_on_the_surface_seen_from_above():
     assert e_shadow[under_bar].sum() == 0 and e_shadow[len(flat):].sum() > 0.1
 
 
+def test_oblique_incidence_absorbs_less_on_slopes():
+    """``beam_incidence: oblique``: on a 45 deg staircase the columns absorb (1 - eta(45)) / (1 - eta0) with
+    eta(45) = 0.891 (eta0 / 0.891)^cos 45 (0.851 for eta0 0.245); 1 on a flat plate, also beside a bar above
+    it (the minmod slope); a flat lattice under the beam keeps all the energy, a sheared one 0.851 of it."""
+    from beadsim.lammps_env import new_lammps
+    from beadsim.sph.driver import deposit_beam, incidence_absorption
+    from beadsim.sph.scene import build_geometry, substrate_positions
+
+    d, eta0 = 1e-4, 0.245
+    i = np.arange(12)
+    stairs = np.tile(i[:, None] * d, (1, 7)).astype(float)  # z = x: 45 deg along x, level along y
+    f = incidence_absorption(stairs, d, eta0)
+    expected = (1 - 0.891 * (eta0 / 0.891) ** math.cos(math.pi / 4)) / (1 - eta0)
+    assert expected == pytest.approx(0.851, abs=1e-3)
+    np.testing.assert_allclose(f, expected, rtol=1e-12)  # one-sided at the edges: the same slope
+    np.testing.assert_allclose(incidence_absorption(np.zeros((5, 5)), d, eta0), 1.0, rtol=1e-12)
+    cliff = np.full((3, 3), -np.inf)
+    cliff[1, 1] = 0.0
+    assert incidence_absorption(cliff, d, eta0)[1, 1] == 1.0  # a lone column has no slope
+    plate = np.zeros((8, 8))
+    plate[:, 3:5] = 10 * d  # a bar above the plate: the plate beside it stays flat, so does the bar's top
+    np.testing.assert_allclose(incidence_absorption(plate, d, eta0), 1.0, rtol=1e-12)
+    params = small_case(beam_layers=1, resolution_mm=0.1, domain_depth_mm=0.3, beam_incidence="oblique")
+    geom = build_geometry(params)
+    flat = substrate_positions(geom)
+    lmp = new_lammps()
+    try:
+        e = np.zeros(len(flat))
+        assert deposit_beam(lmp, params, geom, flat, e, 2.0, 0.0, 0.0, 1e-3, eta0) == pytest.approx(2.0, rel=1e-12)
+        tilted = flat + np.c_[np.zeros((len(flat), 2)), flat[:, 0]]  # the plate sheared to 45 deg along x
+        e = np.zeros(len(flat))
+        got = deposit_beam(lmp, params, geom, tilted, e, 2.0, 0.0, 0.0, 1e-3, eta0)
+    finally:
+        lmp.close()
+    assert e.sum() == pytest.approx(got, rel=1e-12) and got == pytest.approx(2.0 * expected, rel=0.02)
+
+
 def test_compression_density_sees_packing():
     """Kernel-sum density: rho0 inside the undisturbed lattice, rho0 / s^3 (within 1 %) inside a lattice shrunk
     by s, below rho0 at a free surface (where the correction must not act), raised for a collapsed pair; the

@@ -25,6 +25,7 @@ class Material:
     T_boil: float  # K
     surface_tension: float  # N m-1
     contact_angle_deg: float  # degree
+    backscatter: float = float("nan")  # electron backscatter coefficient at normal incidence (optional)
 
     @property
     def diffusivity(self) -> float:
@@ -69,5 +70,7 @@ def get_material(key: str, path: str | Path | None = None, overrides: dict | Non
         raise KeyError(f"material {key!r} is not defined; known materials: {sorted(table)}")
     entry = table[key]
     values = {f: float(entry[src]["value"]) for f, src in _FIELDS.items()}
+    if "backscatter_coefficient" in entry:  # optional: only beam_incidence oblique needs it
+        values["backscatter"] = float(entry["backscatter_coefficient"]["value"])
     values.update(overrides or {})
     return Material(key=key, name=entry.get("name", key), **values)

@@ -442,12 +442,14 @@ def beam_footprint_radius(params: dict) -> float:
 
 
 def deposit_beam(lmp, params: dict, geom: SceneGeometry, x: np.ndarray, esph: np.ndarray, energy: float,
-                 beam_x: float, t0: float, t1: float) -> float:
+                 beam_x: float, t0: float, t1: float, backscatter: float = float("nan")) -> float:
     """Add ``energy`` (J) to the surface seen from above inside the beam footprint; return what was added.
 
     Columns are the dx x dx cells of the substrate lattice in the xy plane. The intensity at each column
     centre that holds any particle is normalised over those columns; a column's share goes in equal parts to
     its particles within (beam_layers - 0.5) dx below its topmost particle (substrate, wire or melt alike).
+    With ``beam_incidence: oblique`` a column absorbs its share times :func:`incidence_absorption` (the
+    material's normal-incidence ``backscatter`` coefficient), and the rest is backscattered: less is added.
     """
     d = geom.dx
     r_fp = beam_footprint_radius(params)
@@ -473,9 +475,42 @@ def deposit_beam(lmp, params: dict, geom: SceneGeometry, x: np.ndarray, esph: np
     total = w.sum()
     if total <= 0:
         return 0.0
-    per_particle = energy * w / total / np.maximum(count, 1)
+    absorbed = w
+    if params["beam_incidence"] == "oblique":
+        absorbed = w * incidence_absorption(top.reshape(n, n), d, backscatter).ravel()
+    per_particle = energy * absorbed / total / np.maximum(count, 1)
     np.add.at(esph, idx, per_particle[cell])
-    return energy
+    return energy * absorbed.sum() / total
+
+
+BACKSCATTER_GRAZING = 0.891  # backscatter coefficient at grazing incidence (Arnal et al. 1969, all Z)
+
+
+def incidence_absorption(top: np.ndarray, d: float, eta0: float) -> np.ndarray:
+    """Absorbed share of the beam on each column relative to a flat surface, from the slope of the column tops.
+
+    ``top``: height (m) of each column's topmost particle on a grid of spacing d (-inf where empty). The slope
+    along each axis is the minmod of the one-sided differences of the tops (the smaller one where both have the
+    same sign, 0 at a crest or trough; one-sided beside an empty column): at an overhang, such as the plate
+    beside the wire above it, the flat side counts, not the step up to the wire. The backscatter coefficient at
+    incidence angle theta follows eta = 0.891 (eta0 / 0.891)^cos(theta) (Arnal et al. 1969), and the factor is
+    (1 - eta(theta)) / (1 - eta0): 1 on a flat surface, 0.85 at 45 deg for Ti (eta0 0.245), 0.15 at grazing.
+    """
+    def slope(z: np.ndarray) -> np.ndarray:
+        fin = np.isfinite(z)
+        zs = np.where(fin, z, 0.0)
+        back, ahead = np.full(z.shape, np.nan), np.full(z.shape, np.nan)
+        ok = fin[1:] & fin[:-1]
+        back[1:][ok] = (zs[1:] - zs[:-1])[ok] / d
+        ahead[:-1][ok] = (zs[1:] - zs[:-1])[ok] / d
+        both = np.isfinite(back) & np.isfinite(ahead)
+        g = np.where(np.isfinite(back), back, np.where(np.isfinite(ahead), ahead, 0.0))
+        mm = np.where(back * ahead > 0, np.where(np.abs(back) < np.abs(ahead), back, ahead), 0.0)
+        return np.where(both, mm, g)
+
+    cos = 1.0 / np.sqrt(1.0 + slope(top) ** 2 + slope(top.T).T ** 2)
+    eta = BACKSCATTER_GRAZING * (eta0 / BACKSCATTER_GRAZING) ** cos
+    return (1.0 - eta) / (1.0 - eta0)
 
 
 # ----------------------------------------------------------------------------------------------- thermo
@@ -531,6 +566,7 @@ class Ledger:
     # where the beam energy landed (parts of ``beam``, not separate terms): solid wire, and melt from the wire
     beam_solid_wire: float = 0.0
     beam_wire_melt: float = 0.0
+    beam_backscattered: float = 0.0  # beam_incidence oblique: lost from sloped surfaces (not part of ``beam``)
 
     def residual(self, now: float) -> float:
         """Energy present minus what the ledger says should be present (J)."""
@@ -595,6 +631,9 @@ class BeadRun:
         self.out = Path(outdir)
         self.progress = progress
         self.mat = material or get_material(params["material"])
+        if params["beam_incidence"] == "oblique" and not math.isfinite(self.mat.backscatter):
+            raise ValueError(f"beam_incidence: oblique needs the material's backscatter_coefficient; material "
+                             f"{self.mat.key!r} has none in the materials file")
         self.geom = build_geometry(params, self.mat)
         self.num = choose_numerics(params, self.mat, self.geom)
         self.thermal = Thermal(self.num.mass, self.mat, bool(params["latent_heat"]), params["mushy_range_K"])
@@ -1243,7 +1282,7 @@ class BeadRun:
         m.update(E_beam=led.beam, E_volumetric=led.volumetric, E_wire_in=led.wire_in,
                  E_evaporated=led.evaporated, E_boundary=led.boundary, E_advected_in=led.advected_in,
                  E_advected_out=led.advected_out, E_ejected=led.ejected, E_beam_solid_wire=led.beam_solid_wire,
-                 E_beam_wire_melt=led.beam_wire_melt)
+                 E_beam_wire_melt=led.beam_wire_melt, E_beam_backscattered=led.beam_backscattered)
         now = m["E_internal"] + m["E_kinetic"] + m["E_potential"] + m.get("E_cohesion", 0.0)
         m["E_residual"] = led.residual(now)
         e_in = led.beam + led.volumetric
@@ -1346,8 +1385,10 @@ class BeadRun:
             bx = self.geom.beam_x(st.t)
             e = self._e()
             e_before = e.copy()
-            st.ledger.beam += deposit_beam(
-                self.lmp, p, self.geom, self._x(), e, power * dt_chunk, bx, st.t, st.t + dt_chunk)
+            added = deposit_beam(self.lmp, p, self.geom, self._x(), e, power * dt_chunk, bx, st.t,
+                                 st.t + dt_chunk, self.mat.backscatter)
+            st.ledger.beam += added
+            st.ledger.beam_backscattered += power * dt_chunk - added
             self._book_beam_targets(e - e_before)
             self._volumetric_heat(dt_chunk)
             natoms = int(self.lmp.get_natoms())

@@ -96,6 +96,12 @@ SPH_PARAMETERS: list[Param] = [
           "stays as solid moving with the substrate until it melts) or rigid (fed on with the wire, the behaviour before "
           "2026-11, which pushes the piece into the substrate)", enum=("fall", "rigid"), short="wdet",
           models=_SPH, long_name="detached wire"),
+    Param("beam_incidence", "string", "flat", "", "beam absorption against the surface slope: flat (every "
+          "column absorbs its share, as in the paper) or oblique (a column whose top slopes at angle theta absorbs "
+          "(1 - eta(theta)) / (1 - eta0) of it, eta(theta) = 0.891 (eta0 / 0.891)^cos(theta) the electron "
+          "backscatter (Arnal et al. 1969), eta0 the material's backscatter_coefficient: 0.85 at 45 deg, so the "
+          "round wire and drops absorb less than the flat pool; the rest is backscattered and booked)",
+          enum=("flat", "oblique"), short="inc", models=_SPH),
     Param("beam_layers", "integer", 2, "1", "particle layers below the top of each column seen from above "
           "that share the beam energy of that column", minimum=1, maximum=10, short="bl", models=_SPH),
     Param("shepard_interval", "integer", 50, "1", "steps between Shepard density filters on the liquid "
