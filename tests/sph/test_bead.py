@@ -281,7 +281,8 @@ def test_resumed_window_run_continues_the_interrupted_one(tmp_path):
 @pytest.mark.parametrize("n_sections", [3, 5])
 def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_sections):
     """``bead_sections``: in the moving window the final bead is the mean height profile (and mean mass balance)
-    of the last ``bead_sections`` cross-sections, with the spread of their widths and heights. The sections here
+    of the last ``bead_sections`` cross-sections, with the spread of their widths and heights; the run means
+    average every section since the wire's metal arrived. The sections here
     are synthetic caps of known size (a humping bead: narrow and wide in turn) on bins whose phase and extent
     differ from section to section, fed through the driver's section check on a real (tiny) LAMMPS scene."""
     from beadsim.sph import surface
@@ -317,6 +318,17 @@ def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_s
     assert m["bead_width_sd_mm"] == pytest.approx(np.std(widths, ddof=1), rel=1e-12) and m["bead_width_sd_mm"] > 0
     assert m["bead_height_sd_mm"] == pytest.approx(np.std(heights, ddof=1), rel=1e-9)
     assert m["mass_balance_sd"] == pytest.approx(np.std(ratios[last], ddof=1), rel=1e-12)
+    # the run means: every section since the wire's metal arrived (the first mass balance >= 1 - steady_tolerance:
+    # 1.3 at 0.10 s), the mean over the humps
+    since = slice(1, None)
+    all_widths = [surface.profile_metrics(y, h, dx)["bead_width_mm"] for h in profiles[since]]
+    assert m["bead_run_from_s"] == pytest.approx(0.10) and m["bead_run_sections"] == len(caps) - 1
+    assert m["bead_width_run_mean_mm"] == pytest.approx(np.mean(all_widths), rel=1e-12)
+    assert m["bead_width_run_sd_mm"] == pytest.approx(np.std(all_widths, ddof=1), rel=1e-12)
+    assert m["bead_height_run_mean_mm"] == pytest.approx(np.mean([hgt * dx * 1e3 for _, hgt in caps[since]]),
+                                                         rel=1e-9)
+    assert m["mass_balance_run_mean"] == pytest.approx(np.mean(ratios[since]), rel=1e-12)
+    assert m["mass_balance_run_sd"] == pytest.approx(np.std(ratios[since], ddof=1), rel=1e-12)
     # stop_at_steady_state waits for bead_sections steady sections: the three that made it steady and later ones
     run.state.steady_time = 0.25  # steady with the sections at 0.15-0.25 s, one more taken since
     assert run._steady_sections_done() == (n_sections <= 4)

@@ -25,3 +25,33 @@ def test_table1_mass_balance(experiments):
     assert mb.loc[3, "ratio_cap"] == pytest.approx(0.51, abs=0.02)
     # A 3.6 mm wide cap must be ~1.29 mm tall to hold the fed 3.39 mm2.
     assert cap_area(3.6, mb.loc[2, "height_if_width_right_mm"]) == pytest.approx(3.393, rel=1e-3)
+
+
+def test_error_table_gives_the_run_means_beside_the_last_sections(experiments):
+    """An SPH window run is compared by its last sections' mean profile and by the run means of its sections
+    (over the humps); a run without run means (the reduced model) gets NaN there, not a made-up value."""
+    import numpy as np
+    import xarray as xr
+
+    from beadsim.compare import error_table
+    from beadsim.study import EXPERIMENT_PARAMS
+
+    mode1 = experiments.loc[1]
+    cases = ["sph_run", "reduced_run"]
+    data = {k: ("case", [mode1[k]] * 2) for k in EXPERIMENT_PARAMS}
+    data.update(model=("case", ["sph", "reduced"]), resolution_mm=("case", [0.4, np.nan]),
+                status=("case", ["ok", "ok"]), bead_width_mm=("case", [3.63, 3.3]),
+                bead_height_mm=("case", [0.9, 1.1]), bead_width_run_mean_mm=("case", [3.135, np.nan]),
+                bead_height_run_mean_mm=("case", [0.8, np.nan]))
+    ds = xr.Dataset(data, coords={"case": cases})
+    t = error_table(ds, experiments).set_index("run_id")
+    w, h = mode1["bead_width_mm"], mode1["bead_height_mm"]
+    assert t.loc["sph_run", "width_err_rel"] == pytest.approx((3.63 - w) / w)
+    assert t.loc["sph_run", "width_run_mean_mm"] == pytest.approx(3.135)
+    assert t.loc["sph_run", "width_run_mean_err_rel"] == pytest.approx((3.135 - w) / w)
+    assert t.loc["sph_run", "height_run_mean_err_rel"] == pytest.approx((0.8 - h) / h)
+    assert np.isnan(t.loc["reduced_run", "width_run_mean_mm"]) and np.isnan(t.loc["reduced_run",
+                                                                                  "height_run_mean_err_rel"])
+    # a dataset of reduced runs only has no run-mean variables at all
+    t = error_table(ds.drop_vars(["bead_width_run_mean_mm", "bead_height_run_mean_mm"]), experiments)
+    assert t["width_run_mean_mm"].isna().all() and len(t) == 2

@@ -14,6 +14,21 @@ METRICS: dict[str, tuple[str, str]] = {
     "bead_height_sd_mm": ("mm", "bead height, standard deviation of the averaged cross-sections (SPH window)"),
     "mass_balance_sd": ("1", "mass balance ratio, standard deviation of the averaged cross-sections (SPH window)"),
     "bead_samples": ("1", "bead cross-sections averaged into the bead metrics (SPH moving window)"),
+    "bead_width_run_mean_mm": ("mm", "bead width, mean of the cross-sections since the wire's metal arrived "
+                               "(SPH window; over the humps of a humping bead)"),
+    "bead_width_run_sd_mm": ("mm", "bead width, standard deviation of the cross-sections since the wire's metal "
+                             "arrived (SPH window)"),
+    "bead_height_run_mean_mm": ("mm", "bead height, mean of the cross-sections since the wire's metal arrived "
+                                "(SPH window)"),
+    "bead_height_run_sd_mm": ("mm", "bead height, standard deviation of the cross-sections since the wire's "
+                              "metal arrived (SPH window)"),
+    "mass_balance_run_mean": ("1", "mass balance ratio, mean of the cross-sections since the wire's metal "
+                              "arrived (SPH window)"),
+    "mass_balance_run_sd": ("1", "mass balance ratio, standard deviation of the cross-sections since the wire's "
+                            "metal arrived (SPH window)"),
+    "bead_run_from_s": ("s", "time of the first cross-section carrying the wire's metal (mass balance within "
+                        "steady_tolerance of 1; SPH window)"),
+    "bead_run_sections": ("1", "cross-sections in the run means (SPH window)"),
     "aspect_ratio": ("1", "bead height / width"),
     "contact_angle_deg": ("degree", "bead contact angle"),
     "penetration_depth_mm": ("mm", "remelt depth into substrate"),

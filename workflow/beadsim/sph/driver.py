@@ -62,6 +62,33 @@ STEADY_SECTIONS = 3
 #: humps has a steady mean only over a stretch longer than a hump.
 SECTION_SPREAD = {"bead_width_mm": "bead_width_sd_mm", "bead_height_mm": "bead_height_sd_mm",
                   "mass_balance_ratio": "mass_balance_sd"}
+#: Per-section bead values averaged over the whole run since the wire's metal arrived (section mass balance first
+#: within steady_tolerance of 1), with their standard deviations: for a bead that humps, the mean over the humps.
+RUN_MEANS = {"bead_width_mm": ("bead_width_run_mean_mm", "bead_width_run_sd_mm"),
+             "bead_height_mm": ("bead_height_run_mean_mm", "bead_height_run_sd_mm"),
+             "mass_balance_ratio": ("mass_balance_run_mean", "mass_balance_run_sd")}
+
+
+def run_section_means(sections: list[dict], tolerance: float) -> dict:
+    """Means and standard deviations of the bead sections' width, height and mass balance over the run since
+    the wire's metal first arrived, i.e. from the first section whose mass balance reaches 1 - ``tolerance``
+    (``bead_run_from_s``, NaN if none did); ``bead_run_sections`` is how many sections that is.
+
+    The bead metrics proper are the mean profile of the last ``bead_sections`` sections; where the bead humps
+    (Ti, mode 1: period 1.2-1.8 s) those are a phase of the hump, and these means over several humps are the
+    answer to set beside a measured bead (the mean of single sections' widths, not the width of a mean profile).
+    """
+    ratio = np.array([s.get("mass_balance_ratio", np.nan) for s in sections], dtype=float)
+    arrived = np.flatnonzero(ratio >= 1 - tolerance)
+    start = int(arrived[0]) if len(arrived) else len(sections)
+    out = {"bead_run_from_s": float(sections[start]["t"]) if len(arrived) else np.nan,
+           "bead_run_sections": len(sections) - start}
+    for key, (mean_key, sd_key) in RUN_MEANS.items():
+        v = np.array([s.get(key, np.nan) for s in sections[start:]], dtype=float)
+        v = v[np.isfinite(v)]
+        out[mean_key] = float(np.mean(v)) if len(v) else np.nan
+        out[sd_key] = float(np.std(v, ddof=1)) if len(v) > 1 else np.nan
+    return out
 
 
 # ----------------------------------------------------------------------------------------------- numerics
@@ -1670,6 +1697,8 @@ class BeadRun:
                     v = v[np.isfinite(v)]
                     out[sd_key] = float(v.std(ddof=1)) if len(v) > 1 else np.nan
                 out["bead_samples"] = len(checks)
+                out.update(run_section_means([m for m in self.series if np.isfinite(m.get("mass_balance_ratio", np.nan))],
+                                             p["steady_tolerance"]))
                 out.update(self._pool_means())
                 y, h, n_used = surface.mean_profile(self.profiles, self.num.dx)
                 if n_used < len(self.profiles):
