@@ -1697,8 +1697,8 @@ class BeadRun:
                     v = v[np.isfinite(v)]
                     out[sd_key] = float(v.std(ddof=1)) if len(v) > 1 else np.nan
                 out["bead_samples"] = len(checks)
-                out.update(run_section_means([m for m in self.series if np.isfinite(m.get("mass_balance_ratio", np.nan))],
-                                             p["steady_tolerance"]))
+                sections = [m for m in self.series if np.isfinite(m.get("mass_balance_ratio", np.nan))]
+                out.update(run_section_means(sections, p["steady_tolerance"]))
                 out.update(self._pool_means())
                 y, h, n_used = surface.mean_profile(self.profiles, self.num.dx)
                 if n_used < len(self.profiles):
@@ -1717,9 +1717,9 @@ class BeadRun:
 
     def _pool_means(self, window: float = 0.25) -> dict:
         """Pool length, width, depth and volume: means (and standard deviations, ``*_sd``) of the bead checks
-        (0.05 s apart, so five of them) in the last ``window`` seconds. The instantaneous extents fluctuate by one or two
-        spacings as melt particles join and leave the pool's edge (pool width: sd 0.4 mm at dx 0.4, mode 2), so
-        a final snapshot is a poor estimate of the steady pool."""
+        (0.05 s apart, so five of them) in the last ``window`` seconds. The instantaneous extents fluctuate by one
+        or two spacings as melt particles join and leave the pool's edge (pool width: sd 0.4 mm at dx 0.4, mode 2),
+        so a final snapshot is a poor estimate of the steady pool."""
         t_end = self.series[-1]["t"]
         checks = [c for c in self.series if "pool_width_mm" in c and c["t"] > t_end - window - 1e-9]
         out = {}
