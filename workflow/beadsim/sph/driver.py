@@ -84,11 +84,21 @@ def run_section_means(sections: list[dict], tolerance: float) -> dict:
     out = {"bead_run_from_s": float(sections[start]["t"]) if len(arrived) else np.nan,
            "bead_run_sections": len(sections) - start}
     for key, (mean_key, sd_key) in RUN_MEANS.items():
-        v = np.array([s.get(key, np.nan) for s in sections[start:]], dtype=float)
-        v = v[np.isfinite(v)]
+        v = _finite_values(sections[start:], key)
         out[mean_key] = float(np.mean(v)) if len(v) else np.nan
-        out[sd_key] = float(np.std(v, ddof=1)) if len(v) > 1 else np.nan
+        out[sd_key] = _sample_sd(v)
     return out
+
+
+def _finite_values(sections: list[dict], key: str) -> np.ndarray:
+    """The finite values of ``key`` over the sections (missing counts as NaN)."""
+    v = np.array([s.get(key, np.nan) for s in sections], dtype=float)
+    return v[np.isfinite(v)]
+
+
+def _sample_sd(v: np.ndarray) -> float:
+    """Sample standard deviation (ddof 1); NaN for fewer than two values."""
+    return float(np.std(v, ddof=1)) if len(v) > 1 else np.nan
 
 
 # ----------------------------------------------------------------------------------------------- numerics
@@ -1686,18 +1696,15 @@ class BeadRun:
         out["liquid_packing"] = float(np.mean(packing)) if packing else np.nan
         if not partial:
             out.update(self._bead_metrics(out["wire_supply_area_mm2"]))
-            n_sections = int(p["bead_sections"])
-            checks = [m for m in self.series if np.isfinite(m.get("mass_balance_ratio", np.nan))][-n_sections:]
+            sections = [m for m in self.series if np.isfinite(m.get("mass_balance_ratio", np.nan))]
+            checks = sections[-int(p["bead_sections"]):]
             if self.geom.moving_window and checks and self.profiles:
                 # the mean of the last bead_sections cross-sections (0.05 s apart; three by default)
                 for key in ("mass_balance_ratio", "penetration_depth_mm", "fusion_width_mm"):
                     out[key] = float(np.nanmean([c.get(key, np.nan) for c in checks]))
                 for key, sd_key in SECTION_SPREAD.items():
-                    v = np.array([c.get(key, np.nan) for c in checks], dtype=float)
-                    v = v[np.isfinite(v)]
-                    out[sd_key] = float(v.std(ddof=1)) if len(v) > 1 else np.nan
+                    out[sd_key] = _sample_sd(_finite_values(checks, key))
                 out["bead_samples"] = len(checks)
-                sections = [m for m in self.series if np.isfinite(m.get("mass_balance_ratio", np.nan))]
                 out.update(run_section_means(sections, p["steady_tolerance"]))
                 out.update(self._pool_means())
                 y, h, n_used = surface.mean_profile(self.profiles, self.num.dx)
