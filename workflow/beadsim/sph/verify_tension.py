@@ -169,15 +169,17 @@ def _run_chunks(lmp, nsteps: int, st: SceneSettings, rho0: float, history_every:
     rho_max) every that many chunks.
     """
     lmp.command("run 0 post no")
-    solid = _local(lmp, "type") == SOLID
-    liq = ~solid
+    n_local = lmp.extract_global("nlocal")
     vmax, rho_lo, rho_hi, history = 0.0, np.inf, -np.inf, []
     nchunks = max(1, nsteps // st.chunk)
     t0 = time.perf_counter()
     for k in range(nchunks):
         lmp.command(f"run {st.chunk} pre no post no")
-        if lmp.extract_global("nlocal") != len(solid):
+        if lmp.extract_global("nlocal") != n_local:
             raise RuntimeError(f"particles left the box after {(k + 1) * st.chunk} steps: the scene blew up")
+        # LAMMPS sorts the local atoms spatially every 1000 steps: masks are taken afresh after every chunk
+        solid = _local(lmp, "type") == SOLID
+        liq = ~solid
         v = _local(lmp, "v")
         rho = _local(lmp, "rho")
         v[solid] = 0.0
@@ -660,19 +662,21 @@ def surface_traction_film(
         lmp.command("fix traction_store all property/atom d_traction ghost no")
         lmp.command("variable traction_fx atom d_traction")
         lmp.command("fix traction all addforce v_traction_fx 0 0")
-        solid = _local(lmp, "type") == SOLID
+        n_local = lmp.extract_global("nlocal")
         lmp.command("run 0 post no")
 
         def run(nsteps: int) -> float:
             vmax = 0.0
             for _ in range(max(1, nsteps // st.chunk)):
                 x = _local(lmp, "x")
+                solid = _local(lmp, "type") == SOLID  # afresh: LAMMPS sorts the local atoms every 1000 steps
                 top = _column_tops(x, dx) & ~solid
                 lmp.numpy.extract_atom("d_traction")[: len(x)] = np.where(
                     top, traction * dx * dx * np.sin(k * x[:, 0]), 0.0)
                 lmp.command(f"run {st.chunk} pre no post no")
-                if lmp.extract_global("nlocal") != len(solid):
+                if lmp.extract_global("nlocal") != n_local:
                     raise RuntimeError("particles left the box: the film blew up")
+                solid = _local(lmp, "type") == SOLID
                 v = _local(lmp, "v")
                 v[solid] = 0.0
                 _local(lmp, "rho")[solid] = mat.rho
@@ -687,6 +691,7 @@ def surface_traction_film(
         lmp.command("run 0 post no")
         vmax = max(vmax, run(n_avg))
         wall = time.perf_counter() - t0
+        solid = _local(lmp, "type") == SOLID
         x = np.array(_local(lmp, "x")[~solid])
         vx = np.array(lmp.numpy.extract_fix("vavg", 1, 1)[: len(solid)][~solid])
     finally:
@@ -708,7 +713,7 @@ def surface_traction_film(
         "dt_s": dt,
         "wall_s": wall,
         "vmax_m_s": vmax,
-        "particles": int(len(solid)),
+        "particles": int(n_local),
     }
 
 
