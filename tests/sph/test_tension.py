@@ -434,5 +434,5 @@ def test_cohesive_melt_holds_a_surface_traction_below_its_yield_stress():
     This documents a limitation of the model: if a change to the cohesion makes the melt flow, the README's
     account of the humps and this test need revisiting."""
     res = _traction_film(True)
-    assert abs(res["flow_ratio"]) < 0.01
+    assert abs(res["flow_ratio"]) < 0.02  # measured 0.004 here; -0.005 to 0.013 across the variants tried
     assert abs(res["u_top"]) < _traction_film(False)["u_top"] / 5
