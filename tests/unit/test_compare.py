@@ -42,7 +42,8 @@ def test_error_table_gives_the_run_means_beside_the_last_sections(experiments):
     data.update(model=("case", ["sph", "reduced"]), resolution_mm=("case", [0.4, np.nan]),
                 status=("case", ["ok", "ok"]), bead_width_mm=("case", [3.63, 3.3]),
                 bead_height_mm=("case", [0.9, 1.1]), bead_width_run_mean_mm=("case", [3.135, np.nan]),
-                bead_height_run_mean_mm=("case", [0.8, np.nan]))
+                bead_height_run_mean_mm=("case", [0.8, np.nan]), bead_width_run_sd_mm=("case", [0.6, np.nan]),
+                bead_height_run_sd_mm=("case", [0.2, np.nan]))
     ds = xr.Dataset(data, coords={"case": cases})
     t = error_table(ds, experiments).set_index("run_id")
     w, h = mode1["bead_width_mm"], mode1["bead_height_mm"]
@@ -50,8 +51,21 @@ def test_error_table_gives_the_run_means_beside_the_last_sections(experiments):
     assert t.loc["sph_run", "width_run_mean_mm"] == pytest.approx(3.135)
     assert t.loc["sph_run", "width_run_mean_err_rel"] == pytest.approx((3.135 - w) / w)
     assert t.loc["sph_run", "height_run_mean_err_rel"] == pytest.approx((0.8 - h) / h)
+    assert t.loc["sph_run", "width_run_sd_mm"] == pytest.approx(0.6)
+    assert np.isnan(t.loc["reduced_run", "height_run_sd_mm"])
+    # the parity plot draws the run means with their spread beside the last sections' bead
+    from beadsim.plots import parity_plot
+
+    fig = parity_plot(t.reset_index(), measured_mass_balance(experiments))
+    for ax, q, sd in zip(fig.axes, ("width", "height"), (0.6, 0.2)):
+        labels = ax.get_legend_handles_labels()[1]
+        assert sum("run mean" in lab for lab in labels) == 1
+        assert ax.get_ylim()[1] >= t.loc["sph_run", f"{q}_run_mean_mm"] + sd
     assert np.isnan(t.loc["reduced_run", "width_run_mean_mm"]) and np.isnan(t.loc["reduced_run",
                                                                                   "height_run_mean_err_rel"])
     # a dataset of reduced runs only has no run-mean variables at all
-    t = error_table(ds.drop_vars(["bead_width_run_mean_mm", "bead_height_run_mean_mm"]), experiments)
-    assert t["width_run_mean_mm"].isna().all() and len(t) == 2
+    t = error_table(ds.drop_vars(["bead_width_run_mean_mm", "bead_height_run_mean_mm", "bead_width_run_sd_mm",
+                                  "bead_height_run_sd_mm"]), experiments)
+    assert t["width_run_mean_mm"].isna().all() and t["height_run_sd_mm"].isna().all() and len(t) == 2
+    fig = parity_plot(t, measured_mass_balance(experiments))
+    assert not any("run mean" in lab for ax in fig.axes for lab in ax.get_legend_handles_labels()[1])

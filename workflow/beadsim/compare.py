@@ -78,7 +78,8 @@ def match_experiments(ds: xr.Dataset, exp: pd.DataFrame) -> dict[str, int]:
 
 def error_table(ds: xr.Dataset, exp: pd.DataFrame) -> pd.DataFrame:
     """Predicted vs measured width and height, absolute and relative errors, for every matching run; for SPH
-    window runs also the run means of the sections (``*_run_mean_*``; NaN where a model has none)."""
+    window runs also the run means of the sections and their standard deviation (``*_run_mean_*``,
+    ``*_run_sd_mm``; NaN where a model has none)."""
     matched = match_experiments(ds, exp)
     balance = measured_mass_balance(exp).set_index("mode")
     rows = []
@@ -97,11 +98,13 @@ def error_table(ds: xr.Dataset, exp: pd.DataFrame) -> pd.DataFrame:
             row[f"{q}_err_mm"] = pred - meas
             row[f"{q}_err_rel"] = (pred - meas) / meas
             # SPH window: the mean of every section since the wire's metal arrived (over the humps, if any)
-            run = f"bead_{q}_run_mean_mm"
-            row[f"{q}_run_mean_mm"] = float(ds[run].values[i]) if run in ds else np.nan
+            for stat in ("mean", "sd"):
+                run = f"bead_{q}_run_{stat}_mm"
+                row[f"{q}_run_{stat}_mm"] = float(ds[run].values[i]) if run in ds else np.nan
             row[f"{q}_run_mean_err_rel"] = (row[f"{q}_run_mean_mm"] - meas) / meas
         rows.append(row)
     cols = ["run_id", "mode", "model", "resolution_mm", "status", "measured_mass_consistent"] + [
         f"{q}_{s}" for q in ("width", "height")
-        for s in ("pred_mm", "meas_mm", "unc_mm", "err_mm", "err_rel", "run_mean_mm", "run_mean_err_rel")]
+        for s in ("pred_mm", "meas_mm", "unc_mm", "err_mm", "err_rel", "run_mean_mm", "run_sd_mm",
+                  "run_mean_err_rel")]
     return pd.DataFrame(rows, columns=cols)

@@ -237,13 +237,28 @@ def _bars(ax, ds, metric):
         ax.set_xlabel(label(ds[metric]))
 
 
+def _run_spread(errors: pd.DataFrame, q: str) -> pd.Series | None:
+    """Standard deviation of the sections around the run mean of ``q`` (0 where not given); None without run
+    means (an error table from before they existed)."""
+    if f"{q}_run_mean_mm" not in errors:
+        return None
+    sd = errors[f"{q}_run_sd_mm"] if f"{q}_run_sd_mm" in errors else pd.Series(0.0, index=errors.index)
+    return sd.fillna(0.0)
+
+
 def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
     """Predicted vs measured bead width and height, one marker per run; hollow where the measured bead fails
-    its own mass balance (the wire fed more metal than the bead holds)."""
+    its own mass balance (the wire fed more metal than the bead holds). SPH window runs with run means (the
+    mean of every section since the wire's metal arrived) get a second marker, x, with the sections' standard
+    deviation as error bar, beside the last sections' bead: for a humping bead the spread is the answer."""
     fig, axes = plt.subplots(1, 2, figsize=(9, 4.2))
     for ax, q in zip(axes, ("width", "height")):
         meas_all = balance[f"measured_{q}_mm"]
-        lim = [0, 1.25 * max(meas_all.max(), errors[f"{q}_pred_mm"].max() if len(errors) else 0)]
+        top = errors[f"{q}_pred_mm"].max() if len(errors) else 0
+        spread = _run_spread(errors, q)
+        if spread is not None:
+            top = np.nanmax([top, (errors[f"{q}_run_mean_mm"] + spread).max()])
+        lim = [0, 1.25 * max(meas_all.max(), top)]
         ax.plot(lim, lim, "k-", lw=1)
         ax.fill_between(lim, [v * 0.95 for v in lim], [v * 1.05 for v in lim], color="0.85", label="+-5 %")
         for k, ((model, res), grp) in enumerate(errors.groupby(["model", "resolution_mm"])):
@@ -253,6 +268,12 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
                 ax.errorbar(part[f"{q}_meas_mm"], part[f"{q}_pred_mm"], xerr=part[f"{q}_unc_mm"], fmt="o",
                             color=f"C{k}", mfc=None if consistent else "none",
                             label=name + ("" if consistent else " (bead fails mass balance)"))
+            runs = ok[ok[f"{q}_run_mean_mm"].notna()] if f"{q}_run_mean_mm" in ok else ok.iloc[:0]
+            if len(runs):
+                # drawn a little to the right of the measured value so that it does not hide the last sections
+                ax.errorbar(runs[f"{q}_meas_mm"] + 0.015 * lim[1], runs[f"{q}_run_mean_mm"],
+                            yerr=_run_spread(runs, q), fmt="x",
+                            color=f"C{k}", capsize=3, label=name + ", run mean +- sd of the sections")
             for _, r in ok.iterrows():
                 ax.annotate(f"m{r['mode']}", (r[f"{q}_meas_mm"], r[f"{q}_pred_mm"]), fontsize=7,
                             xytext=(3, 3), textcoords="offset points")
