@@ -33,12 +33,12 @@ Yield stress
 The cohesive liquid is a solid below a yield stress of ~0.6-0.8 sigma / dx. A film with a shear stress on its
 free surface (:func:`beadsim.sph.verify_tension.surface_traction_film`) holds still up to 0.6 sigma / dx and
 creeps at 1.5-5 % of a Newtonian film's speed at 0.8-1.2 sigma / dx (dx 0.2, 0.3 and 0.4 mm), while the
-plain SPH liquid circulates at 4-17 % at every stress tried (0.03-0.3 sigma / dx). The bulk cohesion and the background
-pressure balancing it, both ~7.7 sigma / dx, pin the particles in place. A bead's shaping stresses (Marangoni
-~80 Pa, gravity ~40 Pa, a bead cap's Laplace pressure ~1 kPa) lie below the 2-3 kPa of dx 0.4 mm, and the
-ratio grows as 1 / dx. Scaling each particle's strength with temperature (a Marangoni term through ``lepton/coul`` and a
-per-particle charge) gave a bulk force along the strength gradient, balanced by a density gradient, and no
-surface flow; it was left out (README, "The cohesive melt has a yield stress").
+plain SPH liquid circulates at 4-17 % at every stress tried (0.03-0.3 sigma / dx). The bulk cohesion and the
+background pressure balancing it, both ~7.7 sigma / dx, pin the particles in place. A bead's shaping stresses
+(Marangoni ~80 Pa, gravity ~40 Pa, a bead cap's Laplace pressure ~1 kPa) lie below the 2-3 kPa of dx 0.4 mm,
+and the ratio grows as 1 / dx. Scaling each particle's strength with temperature (a Marangoni term through
+``lepton/coul`` and a per-particle charge) gave a bulk force along the strength gradient, balanced by a density
+gradient, and no surface flow; it was left out (README, "The cohesive melt has a yield stress").
 
 Wetting
 -------
