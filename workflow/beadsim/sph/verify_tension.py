@@ -17,6 +17,8 @@ slab_tension(...) -> dict
     Kirkwood-Buff virial surface tension of a periodic liquid slab (the calibration route).
 surface_traction_film(...) -> dict
     A film on a plate with a shear stress on its free surface (a Marangoni stress): does it circulate?
+cellular_flow(...) -> dict
+    A periodic bulk under Taylor-Green or Kolmogorov body forces: does it flow where particles must rearrange?
 calibrate(...) -> dict
     C_sigma = sigma dx / s from slabs at several strengths.
 benchmark(...) -> dict
@@ -696,6 +698,102 @@ def surface_traction_film(
         "flow_ratio": u_top / u_s,
         "mu_estimate_Pa_s": mu,
         "traction_over_sigma_dx": traction * dx / mat.surface_tension,
+        "dt_s": dt,
+        "wall_s": develop["wall_s"] + average["wall_s"],
+        "vmax_m_s": max(develop["vmax_m_s"], average["vmax_m_s"]),
+        "particles": average["particles"],
+    }
+
+
+def cellular_flow(
+    material: str | Material = "Ti-Gr2",
+    stress: float = 300.0,
+    liquid: str = "cohesive",
+    pattern: str = "cells",
+    cells: int = 16,
+    depth_cells: int = 6,
+    t_develop: float = 0.02,
+    t_average: float = 5e-3,
+    settings: SceneSettings | None = None,
+    log: str | None = None,
+) -> dict:
+    """Does the bulk liquid flow where the particles must rearrange? A periodic box of liquid (``cells`` dx
+    along x and z, ``depth_cells`` along y, no free surface, no solid) under a steady body force of stress
+    scale ``stress`` = rho F / k, k = 2 pi / (``cells`` dx), F the force per mass.
+
+    ``pattern="cells"``: Taylor-Green cells, F (sin kx cos kz, 0, -cos kx sin kz). The flow stretches and
+    compresses fluid elements, so particles must change neighbours, as in a Marangoni cell or a spreading
+    bead. Stokes solution u = F / (2 nu k^2) times the same pattern.
+    ``pattern="shear"``: Kolmogorov flow, F (sin kz, 0, 0). Layers of constant z slide over each other, which a
+    simple cubic arrangement allows without rearranging. Stokes solution u = F / (nu k^2) sin kz.
+
+    ``liquid``: ``"plain"`` (Tait at rho), ``"background"`` (plain SPH with the cohesive model's shifted Tait
+    reference density, :meth:`CohesionModel.tait_rho0`: the same background pressure, ~7.7 sigma / dx, without
+    the cohesion) or ``"cohesive"`` (the bead model's liquid). The reference speed uses the nominal viscosity
+    mu = rho alpha c0 h / 8 of :func:`surface_traction_film` (an order-of-magnitude estimate).
+
+    Returns
+    -------
+    dict
+        ``amplitude`` (m s-1, least-squares coefficient of the time-averaged velocity on the Stokes pattern),
+        ``u_stokes``, ``flow_ratio`` (their ratio), ``stress_over_sigma_dx``, ``background_pressure_Pa``,
+        ``dt_s``, ``wall_s``, ``vmax_m_s``, ``particles``.
+    """
+    if liquid not in ("plain", "background", "cohesive"):
+        raise ValueError(f"liquid must be 'plain', 'background' or 'cohesive', not {liquid!r}")
+    if pattern not in ("cells", "shear"):
+        raise ValueError(f"pattern must be 'cells' or 'shear', not {pattern!r}")
+    mat = get_material(material) if isinstance(material, str) else material
+    st = settings or SceneSettings()
+    if liquid != "cohesive":
+        st = dataclasses.replace(st, backend="none")
+    model = _model(mat, st, None, 1.0)
+    dx = st.dx
+    half = (cells * dx / 2, depth_cells * dx / 2, cells * dx / 2)
+    k = 2 * math.pi / (cells * dx)
+    lmp = new_lammps(log=log)
+    try:
+        _setup(lmp, st, half, boundary="p p p")
+        lmp.command(f"lattice sc {dx:.6g} origin 0.5 0.5 0.5")
+        lmp.command(f"create_atoms {LIQUID} box")
+        dt = _finish_setup(lmp, mat, model, st)
+        rho0 = mat.rho
+        if liquid == "background":  # the cohesive liquid's background pressure, no cohesion
+            rho0 = model.tait_rho0(mat, st.c0)
+            lmp.command(f"pair_coeff * * sph/taitwater {rho0:.9g} {st.c0} {st.alpha} {model.h:.9g}")
+        m_f = mat.rho * dx**3 * stress * k / mat.rho  # force per particle amplitude, m F
+        if pattern == "cells":
+            lmp.command(f"variable fx atom {m_f:.9g}*sin({k:.9g}*x)*cos({k:.9g}*z)")
+            lmp.command(f"variable fz atom {-m_f:.9g}*cos({k:.9g}*x)*sin({k:.9g}*z)")
+            lmp.command("fix drive all addforce v_fx 0 v_fz")
+        else:
+            lmp.command(f"variable fx atom {m_f:.9g}*sin({k:.9g}*z)")
+            lmp.command("fix drive all addforce v_fx 0 0")
+        develop = _run_chunks(lmp, int(round(t_develop / dt)), st, mat.rho)
+        n_avg = max(st.chunk, int(round(t_average / dt)) // st.chunk * st.chunk)
+        lmp.command("reset_timestep 0")  # fix ave/atom reports on multiples of n_avg
+        lmp.command(f"fix vavg all ave/atom 1 {n_avg} {n_avg} vx vz")
+        average = _run_chunks(lmp, n_avg, st, mat.rho)
+        x = np.array(_local(lmp, "x"))
+        v = np.array(lmp.numpy.extract_fix("vavg", 1, 2)[: len(x)])
+    finally:
+        lmp.close()
+    if pattern == "cells":
+        px = np.sin(k * x[:, 0]) * np.cos(k * x[:, 2])
+        pz = -np.cos(k * x[:, 0]) * np.sin(k * x[:, 2])
+        u_stokes_factor = 0.5
+    else:
+        px, pz = np.sin(k * x[:, 2]), np.zeros(len(x))
+        u_stokes_factor = 1.0
+    amplitude = float(np.sum(v[:, 0] * px + v[:, 1] * pz) / np.sum(px**2 + pz**2))
+    mu = mat.rho * st.alpha * st.c0 * model.h / 8
+    u_stokes = u_stokes_factor * stress / (mu * k)
+    return {
+        "amplitude": amplitude,
+        "u_stokes": u_stokes,
+        "flow_ratio": amplitude / u_stokes,
+        "stress_over_sigma_dx": stress * dx / mat.surface_tension,
+        "background_pressure_Pa": 0.0 if liquid == "plain" else -model.pair_pressure(),
         "dt_s": dt,
         "wall_s": develop["wall_s"] + average["wall_s"],
         "vmax_m_s": max(develop["vmax_m_s"], average["vmax_m_s"]),
