@@ -40,6 +40,14 @@ and the ratio grows as 1 / dx. Scaling each particle's strength with temperature
 ``lepton/coul`` and a per-particle charge) gave a bulk force along the strength gradient, balanced by a density
 gradient, and no surface flow; it was left out (README, "The cohesive melt has a yield stress").
 
+The yield lives in the bulk. In a periodic box with no surface (:func:`beadsim.sph.verify_tension.cellular_flow`)
+Taylor-Green cells, where particles must change neighbours, reach 0.3-1.5 % of the Stokes speed at 100-300 Pa
+(dx 0.4 mm) against 94-98 % for plain SPH, and the background pressure alone, without the cohesion, locks them
+too (4 % at 300 Pa; a quarter of it flows at 90 %): P_b grad W is a pairwise repulsion that cages each particle.
+Layers sliding along lattice planes (Kolmogorov shear) move from ~0.1 sigma / dx. The cohesion needs that
+pressure to balance it, so a pairwise cohesion in an athermal SPH liquid is a particle crystal; see the README,
+"Where the yield stress comes from", for the Couette film, thermal-noise and pair-shape probes.
+
 Wetting
 -------
 Liquid-solid pairs use ``s_ls = wetting_ratio * s_ll`` with the same shape; solid-solid pairs get no cohesive
