@@ -422,7 +422,8 @@ def test_plain_sph_film_circulates_under_a_surface_traction():
     """A surface shear stress of 300 Pa (a few times a Ti pool's Marangoni stress) drives the plain SPH film
     (no cohesion) into a circulation: the surface moves along the traction, the layer on the plate back.
     Measured 2026-12-04: surface speed 4-17 % of the lubrication estimate tau d / (4 mu) with the artificial
-    viscosity's nominal mu (100-2300 Pa, dx 0.2-0.4 mm); 17 % here."""
+    viscosity's nominal mu (100-2300 Pa, dx 0.2-0.4 mm); 17 % here, 23 % of the Stokes film's speed
+    (``u_stokes``). A transient: the plain film loses particles from its surface by 40 ms (2026-12-05)."""
     res = _traction_film(False)
     assert 0.02 < res["flow_ratio"] < 1.0
     assert res["u_bottom"] < 0.0
@@ -436,6 +437,19 @@ def test_cohesive_melt_holds_a_surface_traction_below_its_yield_stress():
     res = _traction_film(True)
     assert abs(res["flow_ratio"]) < 0.02  # measured 0.004 here; -0.005 to 0.013 across the variants tried
     assert abs(res["u_top"]) < _traction_film(False)["u_top"] / 5
+
+
+def test_film_surface_speed_reaches_the_lubrication_and_half_space_limits():
+    """The traction film's Stokes reference: tau d / (4 mu) for a thin film (lubrication, no net flux), tau /
+    (2 mu k) for a deep one (half-space), and in between below both."""
+    tau, mu, d = 300.0, 0.05, 2.4e-3
+    thin = vt.film_surface_speed(tau, mu, 1e-3 / d, d)
+    assert thin == pytest.approx(tau * d / (4 * mu), rel=1e-4)
+    k = 30 / d
+    assert vt.film_surface_speed(tau, mu, k, d) == pytest.approx(tau / (2 * mu * k), rel=1e-6)
+    k = 2 * np.pi / (16 * 4e-4)  # the test film: 16 columns, 6 layers at dx 0.4 mm
+    mid = vt.film_surface_speed(tau, mu, k, d)
+    assert mid < min(tau * d / (4 * mu), tau / (2 * mu * k))
 
 
 @functools.cache
