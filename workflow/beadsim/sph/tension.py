@@ -64,6 +64,18 @@ the weaker liquid-solid cohesion pulls: the liquid is pushed off the solid (part
 melt beside solid expands. :meth:`CohesionModel.solid_tait_rho0` balances the crossing pairs (the driver's
 ``wetting_pressure_balance``); :data:`CONTACT_ANGLE_HYSTERESIS_BALANCED` holds the angles with it.
 
+These tables come from drops, whose contact line crosses the plate's lattice at every orientation. A bead's
+flanks run along a lattice row, and there the melt wets more. Ridges periodic along y
+(:func:`beadsim.sph.verify_tension.sessile_ridge`, the bead's numerics: dx 0.4 mm, c0 4.15 m/s, artificial
+viscosity 0.2, the balance and the smoothed loose-melt ceiling), thermally agitated so that they forget their
+start (``SceneSettings.anneal_speed`` 0.3 m/s; means over 0.25-0.5 s from a wide and a tall start), settle at
+85 / 75 / 72 / 65 / 60 / 52 / 49 degrees at ratio 0.5 / 0.6 / 0.65 / 0.7 / 0.75 / 0.8 / 0.9 (sd of the
+samples 4-7 degrees; 0.6, 0.8 and 0.9 over 0.15-0.3 s), 10-20 degrees below the drop tables. Agitated drops
+with the same numerics settle at 72 (0.7), 63-68 (0.8) and 61 degrees (0.9). Without the agitation a ridge
+stops wherever its start and damping leave it (45 and 124 degrees at ratio 0.8 from a wide and a tall start
+with artificial viscosity 1.0): the angle of an athermal bead is not its equilibrium angle, and beads did not
+follow the ratio (README, "Contact lines along the lattice").
+
 LAMMPS plumbing
 ---------------
 The term is a sub-style of ``pair_style hybrid/overlay`` next to the SPH styles::

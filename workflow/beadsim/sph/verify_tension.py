@@ -19,6 +19,9 @@ surface_traction_film(...) -> dict
     A film on a plate with a shear stress on its free surface (a Marangoni stress): does it circulate?
 film_surface_speed(tau, mu, k, d) -> float
     The Stokes surface speed of that film (its reference).
+sessile_ridge(...) -> dict
+    A ridge on a plate, periodic along its length, started as a rectangle: the contact angle of its flanks,
+    which run along a lattice row as a bead's do.
 cellular_flow(...) -> dict
     A periodic bulk under Taylor-Green or Kolmogorov body forces: does it flow where particles must rearrange?
 calibrate(...) -> dict
@@ -85,6 +88,11 @@ class SceneSettings:
         ``loose_melt_ceiling`` does (:func:`beadsim.sph.driver.relax_loose_density`).
     loose_d3, loose_smoothing : float
         The ceiling's threshold and smoothing radius in dx (``loose_melt_d3``, ``loose_melt_smoothing``).
+    anneal_speed : float
+        Thermal agitation of the liquid, m s-1 (0 = none, as in the bead driver): a DPD thermostat
+        (``pair_style dpd/tstat``, friction ``anneal_friction`` kg s-1 per pair, liquid-liquid pairs only) at
+        kT = m ``anneal_speed``^2. A verification device, not physics: it unpins the cohesive liquid (which is a
+        solid below a yield stress) so that a drop finds its equilibrium contact angle.
     """
 
     dx: float = 3.0e-4
@@ -99,6 +107,8 @@ class SceneSettings:
     loose_ceiling: bool = False
     loose_d3: float = LOOSE_MELT_D3
     loose_smoothing: float = 0.0
+    anneal_speed: float = 0.0
+    anneal_friction: float = 1e-4
 
 
 def _setup(lmp, st: SceneSettings, half: tuple[float, float, float], boundary: str = "f f f"):
@@ -138,6 +148,9 @@ def _finish_setup(
     extra = "" if st.backend == "none" else " " + model.pair_style_tokens()
     sph = "sph/taitwater" if st.morris_viscosity is None else "sph/taitwater/morris"
     visc = st.alpha if st.morris_viscosity is None else st.morris_viscosity
+    if st.anneal_speed > 0:
+        kT = m * st.anneal_speed**2  # DPD temperature in K: kT / k_B (LAMMPS SI units)
+        extra += f" dpd/tstat {kT / 1.380649e-23:.9g} {kT / 1.380649e-23:.9g} {model.h:.9g} 4821"
     lmp.command(f"pair_style hybrid/overlay {sph} sph/heatconduction" + extra)
     rho0 = mat.rho if st.backend == "none" else model.tait_rho0(mat, st.c0)
     lmp.command(f"pair_coeff * * {sph} {rho0:.9g} {st.c0} {visc} {model.h:.9g}")
@@ -145,6 +158,9 @@ def _finish_setup(
         lmp.command(f"pair_coeff {SOLID} {SOLID} {sph} {model.solid_tait_rho0(mat, st.c0):.9g} {st.c0} {visc} "
                     f"{model.h:.9g}")
     lmp.command(f"pair_coeff * * sph/heatconduction {mat.diffusivity:.9g} {model.h:.9g}")
+    if st.anneal_speed > 0:
+        for a, b, gamma in ((LIQUID, LIQUID, st.anneal_friction), (LIQUID, SOLID, 0.0), (SOLID, SOLID, 0.0)):
+            lmp.command(f"pair_coeff {min(a, b)} {max(a, b)} dpd/tstat {gamma:.9g} {model.h:.9g}")
     if st.backend != "none":
         others = [t for t in (LIQUID, SOLID) if t not in cohesive_types]
         with tempfile.TemporaryDirectory() as tmp:  # LAMMPS reads the table during pair_coeff
@@ -513,6 +529,104 @@ def sessile_drop(
         "dt_s": dt,
         "s_ll_N": model.s_ll,
         "x_liquid_m": x,
+        **stats,
+    }
+
+
+def segment_angle(area: float, height: float) -> float:
+    """Contact angle (degree) of the circular segment with cross-section ``area`` and ``height`` (a ridge's
+    cap): A / H^2 = (t - sin t cos t) / (1 - cos t)^2, solved for t. The ratio falls from infinity (a flat
+    film) to pi / 4 (a whole disc, t = 180 deg); nan below that."""
+    def excess(t: float) -> float:
+        return (t - math.sin(t) * math.cos(t)) / (1 - math.cos(t)) ** 2 - area / height**2
+
+    lo, hi = 1e-3, math.pi - 1e-3
+    if excess(lo) * excess(hi) > 0:
+        return float("nan")
+    return math.degrees(brentq(excess, lo, hi))
+
+
+def sessile_ridge(
+    material: str | Material = "Ti-Gr2",
+    wetting_ratio: float = 0.8,
+    width_cells: int = 8,
+    layers: int = 3,
+    length_cells: int = 6,
+    plate_half_cells: int = 12,
+    gravity: float = 9.81,
+    t_end: float = 0.1,
+    t_start: float = 0.05,
+    sample_every: float = 0.01,
+    settings: SceneSettings | None = None,
+    log: str | None = None,
+) -> dict:
+    """A liquid ridge on a frozen plate, periodic along y (the bead's direction), started as a rectangle of
+    ``width_cells`` x ``layers`` spacings: the cross-section it relaxes to and its contact angle.
+
+    Unlike the sessile drop, whose contact line crosses the plate's lattice at every orientation, the ridge's
+    two contact lines run along a lattice row, as a bead's flanks do in the moving window. The cross-section
+    is the y-averaged height map (top particle + dx / 2 per dx-wide column, empty columns as 0); its apparent
+    contact angle is that of the circular segment with the same area and height (:func:`segment_angle`),
+    sampled every ``sample_every`` from ``t_start`` to ``t_end``.
+
+    Returns
+    -------
+    dict
+        ``angle_deg`` and ``angle_sd_deg`` (mean and standard deviation of the samples), ``height_m``,
+        ``width_m`` (columns higher than dx / 2), ``area_m2`` (means of the samples), ``profile_m`` (the last
+        height map across x), ``angles_deg`` (the samples) and the run statistics of the last stretch.
+    """
+    mat = get_material(material) if isinstance(material, str) else material
+    st = settings or SceneSettings()
+    model = _model(mat, st, None, wetting_ratio)
+    dx = st.dx
+    lmp = new_lammps(log=log)
+    samples = []
+    try:
+        half_x, half_y = plate_half_cells * dx, length_cells * dx / 2
+        _setup(lmp, st, (half_x, half_y, (layers + 4) * dx + 3 * model.h), boundary="f p f")
+        lmp.command(f"lattice sc {dx:.6g} origin 0.5 0.5 0.5")
+        lmp.command(f"region plate block INF INF INF INF {-3 * dx:.9g} 0 units box")
+        lmp.command(f"create_atoms {SOLID} region plate")
+        a = width_cells * dx / 2
+        lmp.command(f"region ridge block {-a:.9g} {a:.9g} INF INF 0 {layers * dx:.9g} units box")
+        lmp.command(f"create_atoms {LIQUID} region ridge")
+        dt = _finish_setup(lmp, mat, model, st)
+        if gravity:
+            lmp.command(f"fix grav liquid gravity {gravity} vector 0 0 -1")
+        n_every = max(st.chunk, int(round(sample_every / dt)) // st.chunk * st.chunk)
+        rho_min = model.tait_rho0(mat, st.c0) if st.backend != "none" else mat.rho
+        t = 0.0
+        while t < t_end - 1e-12:
+            stats = _run_chunks(lmp, n_every, st, mat.rho, loose_rho_min=rho_min)
+            t += n_every * dt
+            if t < t_start - 1e-12:
+                continue
+            liquid = _local(lmp, "type") == LIQUID
+            x = np.array(_local(lmp, "x")[liquid])
+            # fixed dx-wide bins: x on the plate's columns, y on the periodic length (estimating the lattice
+            # phase from the moving liquid, as for a bead, can split the periodic length into one bin more)
+            ix = np.floor(x[:, 0] / dx).astype(int) + plate_half_cells
+            iy = np.floor((x[:, 1] + half_y) / dx).astype(int) % length_cells
+            tops = np.zeros((2 * plate_half_cells, length_cells))
+            np.maximum.at(tops, (np.clip(ix, 0, 2 * plate_half_cells - 1), iy), x[:, 2] + 0.5 * dx)
+            profile = tops.mean(axis=1)
+            area, height = float(profile.sum() * dx), float(profile.max())
+            samples.append((segment_angle(area, height), height, float((profile > dx / 2).sum() * dx), area))
+    finally:
+        lmp.close()
+    arr = np.array(samples)
+    return {
+        "wetting_ratio": wetting_ratio,
+        "angle_deg": float(np.nanmean(arr[:, 0])),
+        "angle_sd_deg": float(np.nanstd(arr[:, 0])),
+        "angles_deg": arr[:, 0],
+        "height_m": float(arr[:, 1].mean()),
+        "width_m": float(arr[:, 2].mean()),
+        "area_m2": float(arr[:, 3].mean()),
+        "profile_m": profile,
+        "n_liquid": int(liquid.sum()),
+        "dt_s": dt,
         **stats,
     }
 
