@@ -46,13 +46,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from scipy.constants import Boltzmann as BOLTZMANN
 from scipy.optimize import brentq
 from scipy.spatial import cKDTree
 
 from beadsim.lammps_env import new_lammps
 from beadsim.materials import Material, get_material
 from beadsim.sph.driver import LOOSE_MELT_D3, relax_loose_density
-from beadsim.sph.surface import _column_table
+from beadsim.reduced import cap_shape
+from beadsim.sph.surface import _column_table, profile_metrics
 from beadsim.sph.tension import CohesionModel
 
 LIQUID, SOLID = 1, 2
@@ -149,8 +151,8 @@ def _finish_setup(
     sph = "sph/taitwater" if st.morris_viscosity is None else "sph/taitwater/morris"
     visc = st.alpha if st.morris_viscosity is None else st.morris_viscosity
     if st.anneal_speed > 0:
-        kT = m * st.anneal_speed**2  # DPD temperature in K: kT / k_B (LAMMPS SI units)
-        extra += f" dpd/tstat {kT / 1.380649e-23:.9g} {kT / 1.380649e-23:.9g} {model.h:.9g} 4821"
+        temp = m * st.anneal_speed**2 / BOLTZMANN  # DPD temperature (K) at kT = m v^2, LAMMPS SI units
+        extra += f" dpd/tstat {temp:.9g} {temp:.9g} {model.h:.9g} 4821"
     lmp.command(f"pair_style hybrid/overlay {sph} sph/heatconduction" + extra)
     rho0 = mat.rho if st.backend == "none" else model.tait_rho0(mat, st.c0)
     lmp.command(f"pair_coeff * * {sph} {rho0:.9g} {st.c0} {visc} {model.h:.9g}")
@@ -535,10 +537,11 @@ def sessile_drop(
 
 def segment_angle(area: float, height: float) -> float:
     """Contact angle (degree) of the circular segment with cross-section ``area`` and ``height`` (a ridge's
-    cap): A / H^2 = (t - sin t cos t) / (1 - cos t)^2, solved for t. The ratio falls from infinity (a flat
-    film) to pi / 4 (a whole disc, t = 180 deg); nan below that."""
+    cap): with base width w = 2 H / tan(t / 2) and A = w^2 :func:`beadsim.reduced.cap_shape` (t),
+    A / H^2 = (t - sin t cos t) / (1 - cos t)^2, solved for t. The ratio falls from infinity (a flat film) to
+    pi / 4 (a whole disc, t = 180 deg); nan below that."""
     def excess(t: float) -> float:
-        return (t - math.sin(t) * math.cos(t)) / (1 - math.cos(t)) ** 2 - area / height**2
+        return 4 * cap_shape(t) / math.tan(t / 2) ** 2 - area / height**2
 
     lo, hi = 1e-3, math.pi - 1e-3
     if excess(lo) * excess(hi) > 0:
@@ -573,8 +576,10 @@ def sessile_ridge(
     -------
     dict
         ``angle_deg`` and ``angle_sd_deg`` (mean and standard deviation of the samples), ``height_m``,
-        ``width_m`` (columns higher than dx / 2), ``area_m2`` (means of the samples), ``profile_m`` (the last
-        height map across x), ``angles_deg`` (the samples) and the run statistics of the last stretch.
+        ``width_m``, ``area_m2`` and ``arc_angle_deg`` (means of the samples, by
+        :func:`beadsim.sph.surface.profile_metrics` as for a bead's sections; the arc angle is the bead
+        metrics' ``contact_angle_deg``), ``profile_m`` (the last height map across x), ``angles_deg`` (the
+        samples) and the run statistics of the last stretch.
     """
     mat = get_material(material) if isinstance(material, str) else material
     st = settings or SceneSettings()
@@ -596,6 +601,7 @@ def sessile_ridge(
             lmp.command(f"fix grav liquid gravity {gravity} vector 0 0 -1")
         n_every = max(st.chunk, int(round(sample_every / dt)) // st.chunk * st.chunk)
         rho_min = model.tait_rho0(mat, st.c0) if st.backend != "none" else mat.rho
+        x_centres = (np.arange(2 * plate_half_cells) - plate_half_cells + 0.5) * dx
         t = 0.0
         while t < t_end - 1e-12:
             stats = _run_chunks(lmp, n_every, st, mat.rho, loose_rho_min=rho_min)
@@ -611,8 +617,10 @@ def sessile_ridge(
             tops = np.zeros((2 * plate_half_cells, length_cells))
             np.maximum.at(tops, (np.clip(ix, 0, 2 * plate_half_cells - 1), iy), x[:, 2] + 0.5 * dx)
             profile = tops.mean(axis=1)
-            area, height = float(profile.sum() * dx), float(profile.max())
-            samples.append((segment_angle(area, height), height, float((profile > dx / 2).sum() * dx), area))
+            bead = profile_metrics(x_centres, profile, dx)  # as for a bead's sections
+            area, height = bead["bead_area_mm2"] * 1e-6, bead["bead_height_mm"] * 1e-3
+            samples.append((segment_angle(area, height), height, bead["bead_width_mm"] * 1e-3, area,
+                            bead["contact_angle_deg"]))
     finally:
         lmp.close()
     arr = np.array(samples)
@@ -624,6 +632,7 @@ def sessile_ridge(
         "height_m": float(arr[:, 1].mean()),
         "width_m": float(arr[:, 2].mean()),
         "area_m2": float(arr[:, 3].mean()),
+        "arc_angle_deg": float(np.nanmean(arr[:, 4])),
         "profile_m": profile,
         "n_liquid": int(liquid.sum()),
         "dt_s": dt,
