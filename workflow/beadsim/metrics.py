@@ -54,6 +54,8 @@ METRICS: dict[str, tuple[str, str]] = {
     "energy_balance_error": ("1", "energy balance error (relative to energy in)"),
     "evaporated_energy_J": ("J", "energy removed by the boiling cap"),
     "boundary_heat_loss_J": ("J", "heat leaving through domain boundaries"),
+    "surface_work_J": ("J", "work of the height-function surface forces on the melt (SPH, surface_force "
+                       "height_function; booked in the energy ledger)"),
     "n_particles": ("1", "number of particles"),
     "dx_mm": ("mm", "particle spacing"),
     "dt_s": ("s", "time step"),

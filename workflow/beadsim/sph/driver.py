@@ -33,6 +33,7 @@ import logging
 import math
 import os
 import time
+import dataclasses
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -44,7 +45,8 @@ from beadsim.compare import wire_supply_area
 from beadsim.errors import SimulationFailed
 from beadsim.lammps_env import new_lammps
 from beadsim.materials import Material, get_material
-from beadsim.sph import scene, surface
+from beadsim.sph import heightfn, scene, surface
+from beadsim.sph.tension import laplace_sound_speed
 from beadsim.sph.scene import (FLUID_TYPES, TYPE_FALLING, TYPE_LIQUID, TYPE_RESOLIDIFIED, TYPE_SUBSTRATE,
                                TYPE_WIRE, SceneGeometry, build_geometry)
 
@@ -103,6 +105,11 @@ def _sample_sd(v: np.ndarray) -> float:
 
 # ----------------------------------------------------------------------------------------------- numerics
 
+# time-step factor of the height-function surface force's capillary limit (Brackbill et al.'s sqrt(rho dx^3 /
+# (2 pi sigma)) halved, as for the cohesion: tension.CohesionModel.dt_limit)
+HF_CAPILLARY_FACTOR = 0.125
+
+
 @dataclass(frozen=True)
 class Numerics:
     """Discretisation constants (SI).
@@ -151,15 +158,23 @@ def choose_numerics(params: dict, mat: Material, geom: SceneGeometry) -> Numeric
     v_exp = max(geom.substrate_speed, geom.wire_feed, fall)
     c0 = params["sound_speed_m_s"] or max(10 * v_exp, math.sqrt(GRAVITY * -geom.z_lo / DENSITY_MARGIN))
     angle = params.get("wetting_angle_deg") or mat.contact_angle_deg
-    cohesion = (cohesion_model(mat, dx, h, angle, params["wetting_pressure_balance"])
-                if params["surface_tension"] else None)
+    hf = params["surface_tension"] and params["surface_force"] == "height_function"
+    share = params["height_function_cohesion"] if hf else 1.0  # of sigma carried by the pairwise cohesion
+    cohesion = None
+    if params["surface_tension"] and share > 0:
+        scaled = dataclasses.replace(mat, surface_tension=mat.surface_tension * share)
+        cohesion = cohesion_model(scaled, dx, h, angle, params["wetting_pressure_balance"])
     if cohesion is not None and not params["sound_speed_m_s"]:
         c0 = max(c0, cohesion.min_sound_speed(mat))
+    if hf and not params["sound_speed_m_s"]:  # the height function's Laplace pressures: the same criterion
+        c0 = max(c0, laplace_sound_speed(mat.surface_tension, mat.rho, 2 * h))
     nu = mat.nu if params["viscosity_model"] == "morris" else params["artificial_viscosity"] * c0 * h / 8
     limits = {"acoustic": 0.1 * h / c0, "viscous": 0.125 * h * h / max(nu, 1e-30),
               "thermal": 0.1 * dx * dx / (mat.diffusivity * params["melt_conductivity_factor"]),
               "gravity": 0.25 * math.sqrt(h / GRAVITY)}
     tait_rho0 = solid_tait_rho0 = mat.rho
+    if hf:  # height function: a capillary wave on one column
+        limits["capillary"] = HF_CAPILLARY_FACTOR * math.sqrt(mat.rho * dx ** 3 / (2 * math.pi * mat.surface_tension))
     if cohesion is not None:
         limits["capillary"] = cohesion.dt_limit(mat, dx, c0, params["artificial_viscosity"])
         if params["viscosity_model"] == "morris" or params["artificial_viscosity"] < 0.2:
@@ -604,11 +619,12 @@ class Ledger:
     beam_solid_wire: float = 0.0
     beam_wire_melt: float = 0.0
     beam_backscattered: float = 0.0  # beam_incidence oblique: lost from sloped surfaces (not part of ``beam``)
+    surface_work: float = 0.0  # surface_force height_function: work of the surface forces on the melt
 
     def residual(self, now: float) -> float:
         """Energy present minus what the ledger says should be present (J)."""
         return now - (self.initial + self.beam + self.volumetric + self.wire_in - self.evaporated - self.boundary
-                      + self.advected_in - self.advected_out - self.ejected)
+                      + self.advected_in - self.advected_out - self.ejected + self.surface_work)
 
 
 @dataclass
@@ -702,6 +718,7 @@ class BeadRun:
         # loose_melt_ceiling acts on the cohesive melt only: without cohesion the Tait reference density is
         # rho0 and a loose liquid's pressure already falls with its continuity density
         self.loose_ceiling = bool(params["loose_melt_ceiling"]) and self.num.cohesion is not None
+        self.height_function = bool(params["surface_tension"]) and params["surface_force"] == "height_function"
 
     # ---- setup
     def open(self, resume: bool) -> None:
@@ -845,8 +862,13 @@ class BeadRun:
         else:  # cohesion acts by type: melt and freeze at chunk ends, when the types switch
             cmd(f"variable frozen atom type!={TYPE_LIQUID}&&type!={TYPE_FALLING}")
         cmd("group frozen dynamic all var frozen every 1")
+        if self.height_function:  # the surface force of the chunk and where each particle started it
+            cmd("fix hfstore all property/atom d_hfx d_hfy d_hfz d_hx0 d_hy0 d_hz0 ghost no")
+            for c in "xyz":
+                cmd(f"variable hf{c} atom d_hf{c}")
         if p["resolidified_density"] == "freeze":  # after read_restart, the same ID restores the values
             cmd("fix rhofreeze all property/atom d_rhofreeze ghost no")
+        if p["resolidified_density"] == "freeze" or self.height_function:
             if self.resumed:
                 # LAMMPS keeps the restart file's per-atom fix data until a run initialises, and refuses
                 # create_atoms until then: the window's first new substrate layer (or a wire slice) would stop
@@ -856,6 +878,8 @@ class BeadRun:
             cmd(f"region behind block INF {self.geom.x_lo:.9g} INF INF INF INF units box")
         cmd("fix integrate all sph")
         cmd(f"fix gravity all gravity {GRAVITY} vector 0 0 -1")
+        if self.height_function:
+            cmd("fix hfs all addforce v_hfx v_hfy v_hfz")
         cmd("fix freeze frozen setforce 0.0 0.0 0.0")
         cmd(f"timestep {self.num.dt:.9g}")
         if self.num.cohesion is not None:
@@ -1168,6 +1192,39 @@ class BeadRun:
             touch = np.isfinite(dist)
         self.per_id.landed[allgather_rows(self.lmp, ids[falling][touch])] = True
 
+    def _surface_forces(self) -> None:
+        """surface_force height_function: the Laplace and contact-line forces of :mod:`beadsim.sph.heightfn` on
+        the melt, held over the coming chunk, from the global positions (the same on every rank); the wire and
+        falling wire stay out of the height map, and so does anything above a gap of 1.5 dx (a drop on the
+        wire's tip)."""
+        x, types, ids = self._gather()
+        d, g = self.num.dx, self.geom
+        sub = types == TYPE_SUBSTRATE  # the original lattice moves rigidly: its phase is the columns'
+        phase = [float(np.angle(np.mean(np.exp(2j * np.pi * x[sub, k] / d))) / (2 * np.pi) * d) if sub.any()
+                 else 0.0 for k in (0, 1)]
+        x0 = phase[0] - 0.5 * d + math.floor((g.x_lo - phase[0]) / d) * d
+        y0 = phase[1] - 0.5 * d + math.floor((g.y_lo - phase[1]) / d) * d
+        grid = heightfn.ColumnGrid(x0, y0, d, int(math.ceil((g.x_hi - x0) / d)) + 1,
+                                   int(math.ceil((g.y_hi - y0) / d)) + 1)
+        angle = self.p.get("wetting_angle_deg") or self.mat.contact_angle_deg
+        sigma = self.mat.surface_tension * (1.0 - self.p["height_function_cohesion"])
+        f, _ = heightfn.surface_forces(x, types == TYPE_LIQUID, grid, sigma,
+                                       self.p["height_function_smoothing"], wetting_deg=angle,
+                                       floor=g.z_lo, gap=1.5 * d,
+                                       mapped=(types != TYPE_WIRE) & (types != TYPE_FALLING))
+        where = np.searchsorted(ids, self._ids())
+        x_local = self._x()
+        for k, c in enumerate("xyz"):
+            self.lmp.numpy.extract_atom(f"d_hf{c}")[: len(where)] = f[where, k]
+            self.lmp.numpy.extract_atom(f"d_h{c}0")[: len(where)] = x_local[:, k]
+
+    def _book_surface_work(self) -> None:
+        """Work of the chunk's surface forces, F . (x - x_start) summed over the particles (they carry both)."""
+        n = self._nlocal()
+        f = np.column_stack([self.lmp.numpy.extract_atom(f"d_hf{c}")[:n] for c in "xyz"])
+        x0 = np.column_stack([self.lmp.numpy.extract_atom(f"d_h{c}0")[:n] for c in "xyz"])
+        self.state.ledger.surface_work += allreduce(self.lmp, float(np.einsum("ij,ij->", f, self._x() - x0)))
+
     def _shepard(self, liquid: np.ndarray) -> None:
         """Shepard-normalised density of the liquid particles: rho_i = sum m W / sum (m / rho_j) W."""
         if not liquid.any():
@@ -1319,7 +1376,8 @@ class BeadRun:
         m.update(E_beam=led.beam, E_volumetric=led.volumetric, E_wire_in=led.wire_in,
                  E_evaporated=led.evaporated, E_boundary=led.boundary, E_advected_in=led.advected_in,
                  E_advected_out=led.advected_out, E_ejected=led.ejected, E_beam_solid_wire=led.beam_solid_wire,
-                 E_beam_wire_melt=led.beam_wire_melt, E_beam_backscattered=led.beam_backscattered)
+                 E_beam_wire_melt=led.beam_wire_melt, E_beam_backscattered=led.beam_backscattered,
+                 E_surface_work=led.surface_work)
         now = m["E_internal"] + m["E_kinetic"] + m["E_potential"] + m.get("E_cohesion", 0.0)
         m["E_residual"] = led.residual(now)
         e_in = led.beam + led.volumetric
@@ -1429,12 +1487,16 @@ class BeadRun:
             self._book_beam_targets(e - e_before)
             self._volumetric_heat(dt_chunk)
             natoms = int(self.lmp.get_natoms())
+            if self.height_function:
+                self._surface_forces()
             t_lmp = time.perf_counter()
             try:
                 self.deck(f"run {self.chunk} pre {'yes' if need_setup else 'no'} post no")
             except Exception as exc:  # LAMMPS raises a plain Exception with its error message
                 raise SimulationFailed(f"LAMMPS error at t={st.t:.4g} s: {exc}", self._metrics(partial=True)) from exc
             self.lammps_time += time.perf_counter() - t_lmp
+            if self.height_function:
+                self._book_surface_work()
             st.t += dt_chunk
             st.step += self.chunk
             st.inflow_x -= self.geom.substrate_speed * dt_chunk  # NaN unless moving window
@@ -1679,7 +1741,7 @@ class BeadRun:
                "density_max": st.rho_max, "energy_in_J": st.ledger.beam,
                "energy_balance_error": last.get("energy_error", np.nan),
                "evaporated_energy_J": st.ledger.evaporated, "boundary_heat_loss_J": st.ledger.boundary,
-               "spatter_particles": st.n_ejected,
+               "spatter_particles": st.n_ejected, "surface_work_J": st.ledger.surface_work,
                "absorbed_power_W": p["beam_power_W"] * p["beam_efficiency"]}
         area_w = math.pi * (p["wire_diameter_mm"] / 2) ** 2
         out["wire_supply_area_mm2"] = self._supply_mm2()

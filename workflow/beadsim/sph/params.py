@@ -32,6 +32,19 @@ SPH_PARAMETERS: list[Param] = [
           long_name="fluid pairs only"),
     Param("surface_tension", "boolean", False, "", "add a pairwise cohesive (surface tension) force between "
           "liquid particles (beadsim.sph.tension); off in the paper", short="st", models=_SPH),
+    Param("surface_force", "string", "pairwise", "", "how surface_tension acts: pairwise (a cohesive pair force "
+          "between melt particles; verified in drop tests, but it makes the melt a particle crystal with a yield "
+          "stress of ~0.1-0.6 sigma / dx) or height_function (a plain SPH melt with the Laplace force "
+          "sigma kappa on the top particle of each column, kappa from the column height map, and a contact-line "
+          "pull sigma (1 - cos theta) set by wetting_angle_deg; beadsim.sph.heightfn)",
+          enum=("pairwise", "height_function"), short="sf", models=_SPH),
+    Param("height_function_smoothing", "number", 1.0, "1", "surface_force height_function: Gaussian smoothing "
+          "of the column height map before its curvature is taken, in columns (0 = none)", minimum=0,
+          maximum=5, short="hfs", models=_SPH, long_name="height-function smoothing"),
+    Param("height_function_cohesion", "number", 0.0, "1", "surface_force height_function: share of sigma "
+          "carried by the pairwise cohesion beside the height-function force (which carries the rest); the "
+          "column force holds no particle to its neighbours, the cohesion does", minimum=0, maximum=1,
+          short="hfc", models=_SPH, long_name="height-function cohesion share"),
     Param("wetting_pressure_balance", "boolean", False, "", "surface tension with a wetting ratio below 1: give "
           "the solid particle types a Tait reference density at which their pressure balances the weaker "
           "liquid-solid cohesion across the interface ((2 r - 1) times the liquid's background pressure; "

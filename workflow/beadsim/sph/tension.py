@@ -453,5 +453,11 @@ class CohesionModel:
         density_error : float
             Allowed relative compression.
         """
-        radius = 2 * self.h if radius is None else radius
-        return math.sqrt(2 * self.sigma / radius / (material.rho * density_error))
+        return laplace_sound_speed(self.sigma, material.rho, 2 * self.h if radius is None else radius,
+                                   density_error)
+
+
+def laplace_sound_speed(sigma: float, rho: float, radius: float, density_error: float = 0.02) -> float:
+    """Smallest Tait sound speed (m s-1) at which the Laplace pressure 2 sigma / radius compresses a liquid of
+    density rho by no more than ``density_error`` (delta rho / rho ~ p / (rho c0^2))."""
+    return math.sqrt(2 * sigma / radius / (rho * density_error))

@@ -54,6 +54,8 @@ from beadsim.lammps_env import new_lammps
 from beadsim.materials import Material, get_material
 from beadsim.sph.driver import LOOSE_MELT_D3, relax_loose_density
 from beadsim.reduced import cap_shape
+from beadsim.sph.heightfn import ColumnGrid
+from beadsim.sph.heightfn import surface_forces as height_function_forces
 from beadsim.sph.surface import _column_table, profile_metrics
 from beadsim.sph.tension import CohesionModel
 
@@ -562,6 +564,10 @@ def sessile_ridge(
     sample_every: float = 0.01,
     settings: SceneSettings | None = None,
     log: str | None = None,
+    surface_force: str = "pairwise",
+    wetting_deg: float = 60.0,
+    smooth_cells: float = 1.0,
+    cohesion_share: float = 0.0,
 ) -> dict:
     """A liquid ridge on a frozen plate, periodic along y (the bead's direction), started as a rectangle of
     ``width_cells`` x ``layers`` spacings: the cross-section it relaxes to and its contact angle.
@@ -571,6 +577,12 @@ def sessile_ridge(
     is the y-averaged height map (top particle + dx / 2 per dx-wide column, empty columns as 0); its apparent
     contact angle is that of the circular segment with the same area and height (:func:`segment_angle`),
     sampled every ``sample_every`` from ``t_start`` to ``t_end``.
+
+    ``surface_force`` "height_function" replaces the cohesion by the bead driver's height-function surface
+    force (:mod:`beadsim.sph.heightfn`) on a plain SPH liquid (Tait at rho, no cohesion): set contact angle
+    ``wetting_deg``, map smoothing ``smooth_cells``, forces held over each chunk; ``wetting_ratio`` is then
+    unused unless ``cohesion_share`` > 0: then the pairwise cohesion (at ``wetting_ratio``) carries that share of
+    sigma and the height function the rest (the driver's ``height_function_cohesion``).
 
     Returns
     -------
@@ -583,6 +595,14 @@ def sessile_ridge(
     """
     mat = get_material(material) if isinstance(material, str) else material
     st = settings or SceneSettings()
+    if surface_force not in ("pairwise", "height_function"):
+        raise ValueError(f"surface_force {surface_force!r}: allowed pairwise, height_function")
+    height_function = surface_force == "height_function"
+    sigma_hf = mat.surface_tension * (1.0 - cohesion_share)
+    if height_function and cohesion_share > 0:
+        mat = dataclasses.replace(mat, surface_tension=mat.surface_tension * cohesion_share)
+    elif height_function:
+        st = dataclasses.replace(st, backend="none")
     model = _model(mat, st, None, wetting_ratio)
     dx = st.dx
     lmp = new_lammps(log=log)
@@ -599,12 +619,26 @@ def sessile_ridge(
         dt = _finish_setup(lmp, mat, model, st)
         if gravity:
             lmp.command(f"fix grav liquid gravity {gravity} vector 0 0 -1")
+        apply = None
+        if height_function:
+            lmp.command("fix hfstore all property/atom d_hfx d_hfy d_hfz ghost no")
+            for c in "xyz":
+                lmp.command(f"variable hf{c} atom d_hf{c}")
+            lmp.command("fix hf all addforce v_hfx v_hfy v_hfz")
+            grid = ColumnGrid(-half_x, -half_y, dx, 2 * plate_half_cells, length_cells, periodic_y=True)
+
+            def apply() -> None:  # masks afresh: LAMMPS sorts atoms
+                x = np.array(_local(lmp, "x"))
+                f, _ = height_function_forces(x, _local(lmp, "type") == LIQUID, grid, sigma_hf,
+                                              smooth_cells, wetting_deg=wetting_deg)
+                for k, c in enumerate("xyz"):
+                    lmp.numpy.extract_atom(f"d_hf{c}")[: len(x)] = f[:, k]
         n_every = max(st.chunk, int(round(sample_every / dt)) // st.chunk * st.chunk)
         rho_min = model.tait_rho0(mat, st.c0) if st.backend != "none" else mat.rho
         x_centres = (np.arange(2 * plate_half_cells) - plate_half_cells + 0.5) * dx
         t = 0.0
         while t < t_end - 1e-12:
-            stats = _run_chunks(lmp, n_every, st, mat.rho, loose_rho_min=rho_min)
+            stats = _run_chunks(lmp, n_every, st, mat.rho, loose_rho_min=rho_min, before_chunk=apply)
             t += n_every * dt
             if t < t_start - 1e-12:
                 continue
