@@ -31,9 +31,9 @@ from __future__ import annotations
 import json
 import logging
 import math
+import dataclasses
 import os
 import time
-import dataclasses
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -46,7 +46,7 @@ from beadsim.errors import SimulationFailed
 from beadsim.lammps_env import new_lammps
 from beadsim.materials import Material, get_material
 from beadsim.sph import heightfn, scene, surface
-from beadsim.sph.tension import laplace_sound_speed
+from beadsim.sph.tension import capillary_dt_limit, laplace_sound_speed
 from beadsim.sph.scene import (FLUID_TYPES, TYPE_FALLING, TYPE_LIQUID, TYPE_RESOLIDIFIED, TYPE_SUBSTRATE,
                                TYPE_WIRE, SceneGeometry, build_geometry)
 
@@ -105,11 +105,6 @@ def _sample_sd(v: np.ndarray) -> float:
 
 # ----------------------------------------------------------------------------------------------- numerics
 
-# time-step factor of the height-function surface force's capillary limit (Brackbill et al.'s sqrt(rho dx^3 /
-# (2 pi sigma)) halved, as for the cohesion: tension.CohesionModel.dt_limit)
-HF_CAPILLARY_FACTOR = 0.125
-
-
 @dataclass(frozen=True)
 class Numerics:
     """Discretisation constants (SI).
@@ -125,6 +120,9 @@ class Numerics:
     tait_rho0 : reference density of the Tait equation (kg/m^3): rho, or lower with surface tension
     solid_tait_rho0 : that of the solid particle types (``wetting_pressure_balance``; else tait_rho0)
     cohesion : the :class:`beadsim.sph.tension.CohesionModel` when surface tension is on, else None
+    height_function : surface tension acts (also) through the height-function surface force
+    height_function_sigma : the share of sigma it carries (N/m)
+    wetting_deg : the contact angle set (degree): ``wetting_angle_deg`` or the material's
     """
 
     dx: float
@@ -137,6 +135,9 @@ class Numerics:
     tait_rho0: float
     solid_tait_rho0: float
     cohesion: object = None
+    height_function: bool = False
+    height_function_sigma: float = 0.0
+    wetting_deg: float = 0.0
 
 
 def choose_numerics(params: dict, mat: Material, geom: SceneGeometry) -> Numerics:
@@ -174,7 +175,7 @@ def choose_numerics(params: dict, mat: Material, geom: SceneGeometry) -> Numeric
               "gravity": 0.25 * math.sqrt(h / GRAVITY)}
     tait_rho0 = solid_tait_rho0 = mat.rho
     if hf:  # height function: a capillary wave on one column
-        limits["capillary"] = HF_CAPILLARY_FACTOR * math.sqrt(mat.rho * dx ** 3 / (2 * math.pi * mat.surface_tension))
+        limits["capillary"] = capillary_dt_limit(mat.rho, dx, mat.surface_tension)
     if cohesion is not None:
         limits["capillary"] = cohesion.dt_limit(mat, dx, c0, params["artificial_viscosity"])
         if params["viscosity_model"] == "morris" or params["artificial_viscosity"] < 0.2:
@@ -190,7 +191,8 @@ def choose_numerics(params: dict, mat: Material, geom: SceneGeometry) -> Numeric
                         "pressure needs and expands; set wetting_pressure_balance", cohesion.wetting_ratio)
     dt = params["dt_factor"] * min(limits.values())
     return Numerics(dx=dx, h=h, mass=mat.rho * dx ** 3, c0=c0, dt=dt, limits=limits, expected_speed=v_exp,
-                    tait_rho0=tait_rho0, solid_tait_rho0=solid_tait_rho0, cohesion=cohesion)
+                    tait_rho0=tait_rho0, solid_tait_rho0=solid_tait_rho0, cohesion=cohesion, height_function=hf,
+                    height_function_sigma=mat.surface_tension * (1.0 - share) if hf else 0.0, wetting_deg=angle)
 
 
 def fluid_pair_types(fluid_pairs_only: bool, per_type: bool = False) -> list[tuple[str, str, bool]]:
@@ -718,7 +720,7 @@ class BeadRun:
         # loose_melt_ceiling acts on the cohesive melt only: without cohesion the Tait reference density is
         # rho0 and a loose liquid's pressure already falls with its continuity density
         self.loose_ceiling = bool(params["loose_melt_ceiling"]) and self.num.cohesion is not None
-        self.height_function = bool(params["surface_tension"]) and params["surface_force"] == "height_function"
+        self.height_function = self.num.height_function
 
     # ---- setup
     def open(self, resume: bool) -> None:
@@ -1206,10 +1208,8 @@ class BeadRun:
         y0 = phase[1] - 0.5 * d + math.floor((g.y_lo - phase[1]) / d) * d
         grid = heightfn.ColumnGrid(x0, y0, d, int(math.ceil((g.x_hi - x0) / d)) + 1,
                                    int(math.ceil((g.y_hi - y0) / d)) + 1)
-        angle = self.p.get("wetting_angle_deg") or self.mat.contact_angle_deg
-        sigma = self.mat.surface_tension * (1.0 - self.p["height_function_cohesion"])
-        f, _ = heightfn.surface_forces(x, types == TYPE_LIQUID, grid, sigma,
-                                       self.p["height_function_smoothing"], wetting_deg=angle,
+        f, _ = heightfn.surface_forces(x, types == TYPE_LIQUID, grid, self.num.height_function_sigma,
+                                       self.p["height_function_smoothing"], wetting_deg=self.num.wetting_deg,
                                        floor=g.z_lo, gap=1.5 * d,
                                        mapped=(types != TYPE_WIRE) & (types != TYPE_FALLING))
         where = np.searchsorted(ids, self._ids())

@@ -120,11 +120,11 @@ def _grad(f: np.ndarray, dx: float, periodic_y: bool) -> tuple[np.ndarray, np.nd
 
 
 def surface_forces(x: np.ndarray, movable: np.ndarray, grid: ColumnGrid, sigma: float,
-                   smooth_cells: float = 1.0, wetting_deg: float | None = None, kappa_max: float | None = None,
-                   floor: float = 0.0, gap: float | None = None, mapped: np.ndarray | None = None
+                   smooth_cells: float = 1.0, wetting_deg: float | None = None, floor: float = 0.0,
+                   gap: float | None = None, mapped: np.ndarray | None = None
                    ) -> tuple[np.ndarray, dict]:
     """Force (N, 3), newtons, on every particle: sigma kappa dx^2 (H_x, H_y, -1) on the highest particle of
-    each column where that particle is ``movable`` (melt), zero elsewhere. ``kappa_max`` (1/m) caps |kappa|.
+    each column where that particle is ``movable`` (melt), zero elsewhere.
 
     The map runs over the bare solid too, where it is flat; there the surface energy it stands for is that of
     the liquid's, so on its own the force wets completely (the kink where the melt meets the solid pulls the
@@ -139,8 +139,6 @@ def surface_forces(x: np.ndarray, movable: np.ndarray, grid: ColumnGrid, sigma: 
     H, top_m = column_tops(x[idx], grid, floor, gap)
     top = np.where(top_m >= 0, idx[np.maximum(top_m, 0)], -1)
     kappa, hx, hy = curvature(H, grid.dx, smooth_cells, grid.periodic_y)
-    if kappa_max is not None:
-        kappa = np.clip(kappa, -kappa_max, kappa_max)
     f = np.zeros_like(x, dtype=float)
     sel = top >= 0
     sel[sel] &= movable[top[sel]]
@@ -152,12 +150,8 @@ def surface_forces(x: np.ndarray, movable: np.ndarray, grid: ColumnGrid, sigma: 
         for axis in (0, 1):
             for shift in (1, -1):  # the neighbour at index - shift; the pull points along +shift
                 nb = np.roll(solid, shift, axis=axis)
-                if axis == 0 or not grid.periodic_y:
-                    edge = (slice(0, 1) if shift == 1 else slice(-1, None))
-                    if axis == 0:
-                        nb[edge, :] = False
-                    else:
-                        nb[:, edge] = False
+                if axis == 0 or not grid.periodic_y:  # no neighbour across a non-periodic edge
+                    np.moveaxis(nb, axis, 0)[0 if shift == 1 else -1] = False
                 cols = top[sel & nb]
                 f[cols, axis] += shift * pull
     return f, {"H": H, "kappa": kappa, "top": top, "melt": sel}

@@ -433,8 +433,7 @@ class CohesionModel:
         held; alpha 0.2: 7.5 us unstable, 5 us (0.083) held; alpha 0.5: 7.5 us (0.125) held. f is interpolated
         linearly in alpha between 0.058 at 0.1 and 0.125 at 0.5 and kept at those values outside.
         """
-        factor = 0.125
-        dt = factor * math.sqrt(material.rho * dx**3 / (2 * math.pi * self.sigma))
+        dt = capillary_dt_limit(material.rho, dx, self.sigma)
         if c0 is not None:
             f = float(np.interp(alpha, [0.1, 0.2, 0.5], [0.058, 0.083, 0.125]))
             dt = min(dt, f * self.h / self.effective_sound_speed(material, c0))
@@ -461,3 +460,9 @@ def laplace_sound_speed(sigma: float, rho: float, radius: float, density_error: 
     """Smallest Tait sound speed (m s-1) at which the Laplace pressure 2 sigma / radius compresses a liquid of
     density rho by no more than ``density_error`` (delta rho / rho ~ p / (rho c0^2))."""
     return math.sqrt(2 * sigma / radius / (rho * density_error))
+
+
+def capillary_dt_limit(rho: float, dx: float, sigma: float) -> float:
+    """Capillary time-step limit, s: 0.125 sqrt(rho dx^3 / (2 pi sigma)), half the textbook factor of
+    Brackbill et al. (1992); the cohesion's (:meth:`CohesionModel.dt_limit`) and the height function's."""
+    return 0.125 * math.sqrt(rho * dx**3 / (2 * math.pi * sigma))
