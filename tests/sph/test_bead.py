@@ -38,6 +38,12 @@ def small_case(**overrides) -> dict:
     return p
 
 
+#: the small bead's settings for surface_force height_function (plain SPH melt, column surface force);
+#: density_tolerance 0.5: the melt reaches the thin plate's bottom face
+HEIGHT_FUNCTION = dict(surface_tension=True, surface_force="height_function", wetting_angle_deg=45.0,
+                       height_function_smoothing=2.0, artificial_viscosity=0.5, density_tolerance=0.5)
+
+
 @pytest.fixture(scope="module")
 def small_bead(tmp_path_factory):
     """Run the small bead once; return (params, metrics, outdir)."""
@@ -122,9 +128,7 @@ def test_height_function_bead_books_the_surface_work(tmp_path):
     """The small bead with surface_force height_function (plain SPH melt, column surface force): the ledger
     closes with the forces' work booked at every sample, the work is not negligible against what the ledger
     must close to, and the melt keeps its density."""
-    params = small_case(surface_tension=True, surface_force="height_function", wetting_angle_deg=45.0,
-                        height_function_smoothing=2.0, artificial_viscosity=0.5, sim_time_s=0.4,
-                        density_tolerance=0.5)  # melt reaches the thin plate's bottom face
+    params = small_case(**HEIGHT_FUNCTION, sim_time_s=0.4)
     m = run_case(params, tmp_path)
     ts = xr.open_dataset(tmp_path / "timeseries.nc")
     closure = (ts.E_residual / ts.E_beam).where(ts.E_beam > 0)

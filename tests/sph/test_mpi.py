@@ -14,7 +14,7 @@ from beadsim.errors import SimulationFailed
 from beadsim.sph.driver import run_case
 from beadsim.sph.mpi_main import run_mpi
 
-from test_bead import small_case
+from test_bead import HEIGHT_FUNCTION, small_case
 
 
 @pytest.mark.mpi
@@ -84,7 +84,6 @@ def test_smoothed_loose_melt_ceiling_on_two_ranks(tmp_path):
     assert series[1]["E_internal"][-1].item() == pytest.approx(series[0]["E_internal"][-1].item(), rel=0.01)
 
 
-
 @pytest.mark.mpi
 def test_height_function_on_two_ranks(tmp_path):
     """surface_force height_function: the column height map is built from the gathered positions (the same on
@@ -93,9 +92,7 @@ def test_height_function_on_two_ranks(tmp_path):
     (measured 2026-12-05 over 0.25 s: same up to 0.03 s, surface work 0.351 / 0.351 uJ there; at 0.25 s 24.7 /
     26.9 uJ, stored energy 1.5 %, 2 / 3 single particles thrown out). So compare over the first 0.03 s, where a
     force written to the wrong particle would show."""
-    params = small_case(sim_time_s=0.03, surface_tension=True, surface_force="height_function",
-                        wetting_angle_deg=45.0, height_function_smoothing=2.0, artificial_viscosity=0.5,
-                        density_tolerance=0.5)
+    params = small_case(**HEIGHT_FUNCTION, sim_time_s=0.03)
     one = run_case(params, tmp_path / "one")
     two = run_mpi(params, tmp_path / "two", tasks=2)
     assert two["n_particles"] + two["spatter_particles"] == one["n_particles"] + one["spatter_particles"]
