@@ -227,10 +227,11 @@ def test_oblique_incidence_absorbs_less_on_slopes():
 def test_compression_density_sees_packing():
     """Kernel-sum density: rho0 inside the undisturbed lattice, rho0 / s^3 (within 1 %) inside a lattice shrunk
     by s, below rho0 at a free surface (where the correction must not act), raised for a collapsed pair; the
-    targets are the sources and exactly the particles within h of them."""
+    targets are the sources and exactly the particles within h of them; on a jittered cloud the sums equal a dense
+    double sum (coincident particles included)."""
     from scipy.spatial.distance import cdist
 
-    from beadsim.sph.driver import compression_density
+    from beadsim.sph.driver import compression_density, lattice_volume_fraction, lucy_kernel
 
     dx, h, rho0 = 0.3e-3, 0.75e-3, 4420.0
     g = np.arange(-5, 6) * dx
@@ -250,6 +251,17 @@ def test_compression_density_sees_packing():
     paired = lattice.copy()
     paired[centre] += [0.5 * dx, 0.0, 0.0]  # the centre particle halfway to its +x neighbour
     assert at(paired, centre)[0] > 1.01 * rho0
+    # a jittered cloud with scattered sources and two particles on one spot, against the dense double sum
+    rng = np.random.default_rng(7)
+    cloud = lattice + rng.normal(0.0, 0.15 * dx, lattice.shape)
+    cloud[1] = cloud[0]
+    sources = np.sort(np.r_[0, rng.choice(len(cloud), 12, replace=False)])
+    r = cdist(cloud, cloud)
+    expected = np.flatnonzero((r[:, sources] <= h).any(axis=1))
+    kernel = lucy_kernel(r[expected], h).sum(axis=1) * dx ** 3 / lattice_volume_fraction(dx, h) * rho0
+    targets, rho = compression_density(cloud, sources, dx, h, rho0)
+    assert np.array_equal(targets, expected)
+    assert rho == pytest.approx(kernel, rel=1e-12)
 
 
 def test_moving_window_conserves_energy_and_feeds_substrate(tmp_path):

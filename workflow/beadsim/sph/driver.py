@@ -355,18 +355,18 @@ def compression_density(x_all: np.ndarray, sources: np.ndarray, dx: float, h: fl
     if len(sources) == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0)
     xs = x_all[sources]
-    # neighbours of the targets lie within 2 h of a source
-    box = np.flatnonzero(((x_all >= xs.min(axis=0) - 2 * h) & (x_all <= xs.max(axis=0) + 2 * h)).all(axis=1))
-    box = box[np.isfinite(cKDTree(xs).query(x_all[box], distance_upper_bound=2 * h)[0])]
-    xb = x_all[box]
-    i, j = cKDTree(xb).query_pairs(h, output_type="ndarray").T
-    w = lucy_kernel(np.linalg.norm(xb[i] - xb[j], axis=1), h)
-    phi = dx ** 3 * (lucy_kernel(np.zeros(1), h)[0] + np.bincount(i, w, len(box)) + np.bincount(j, w, len(box)))
-    is_source = np.isin(box, sources)
-    near = is_source.copy()
-    near[i[is_source[j]]] = True
-    near[j[is_source[i]]] = True
-    return box[near], rho0 * phi[near] / lattice_volume_fraction(dx, h)
+    # the targets' neighbours lie within 2 h of a source
+    box = within_box(x_all, xs.min(axis=0) - 2 * h, xs.max(axis=0) + 2 * h)
+    tree = cKDTree(x_all[box])
+    # the targets: every particle within h of a source, the sources themselves included (distance 0)
+    near = np.union1d(cKDTree(xs).sparse_distance_matrix(tree, h, output_type="ndarray")["j"],
+                      np.searchsorted(box, sources))
+    # each target with its neighbours: sum over the pairs (the target itself, listed or not, added once below)
+    pairs = cKDTree(x_all[box[near]]).sparse_distance_matrix(tree, h, output_type="ndarray")
+    other = pairs["j"] != near[pairs["i"]]
+    w = lucy_kernel(pairs["v"][other], h)
+    phi = dx ** 3 * (lucy_kernel(np.zeros(1), h)[0] + np.bincount(pairs["i"][other], w, len(near)))
+    return box[near], rho0 * phi / lattice_volume_fraction(dx, h)
 
 
 #: Mean distance to the three nearest neighbours (in dx) above which a melt particle counts as loosely packed
@@ -379,7 +379,8 @@ def compression_density(x_all: np.ndarray, sources: np.ndarray, dx: float, h: fl
 #: 1.07 and 30: 1.06 / 0.97 (a neutral band between 1.0 and the threshold is left loose).
 #: The smoothed form (``loose_melt_smoothing``: d3 averaged within a radius, only loose regions capped) on the
 #: same drops, 200 steps: threshold 0.985 and radius 1.5 dx give 1.00 / 0.965, the dense drop as without any
-#: ceiling (0.965, 74 deg; the first form 0.93, 72 deg); 1.0 and 1.5: 1.05 / 0.97; 1.0 and 2.0: 1.11 / 0.98;
+#: ceiling (0.965, 74 deg; the first form 0.93, 72 deg; single samples: rounding alone moves the dense drop
+#: by +-0.02, README "The smoothed ceiling"); 1.0 and 1.5: 1.05 / 0.97; 1.0 and 2.0: 1.11 / 0.98;
 #: 1.0 and 1.2: 1.03 / 0.96; 0.97 and 1.5: 0.98 / 0.94 (a threshold below dx caps a lattice at rho0 times its
 #: cube; a dense liquid at the lattice's number density has d3 of about 0.92 dx). Capping compressed
 #: particles too (as the first form does) with 0.985 and 1.5: 1.01 / 0.95.
@@ -390,6 +391,25 @@ LOOSE_MELT_D3 = 1.0
 #: the fastest particle reached 1.25 m/s relaxing over 30 steps (threshold 1.07 dx), 0.66 over 100 and 0.74
 #: over 200 (threshold dx); 200 steps are 2.2 ms at dx 0.4, about five capillary times sqrt(rho dx^3 / sigma).
 LOOSE_MELT_RELAX_STEPS = 200
+
+
+def within_box(x_all: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Indices of the particles of ``x_all`` (N, 3) inside the box [lo, hi] (m)."""
+    return np.flatnonzero(((x_all >= lo) & (x_all <= hi)).all(axis=1))
+
+
+def mean_nearest3(x_all: np.ndarray, xq: np.ndarray, lo: np.ndarray, hi: np.ndarray, tree: cKDTree) -> np.ndarray:
+    """Mean distance (m) from each of the particles at ``xq`` (members of ``x_all``) to its three nearest
+    others (inf where fewer exist), searched in ``tree``, a tree of the particles of ``x_all`` inside the box
+    [lo, hi] that holds ``xq``: exact for a particle whose third neighbour lies nearer than the box's faces,
+    searched again among all particles otherwise (a stray particle). The box keeps the tree to the melt's
+    surroundings (a tree over the whole scene, ~7k particles at dx 0.4, cost more than the rest of the
+    ceiling)."""
+    dist, _ = tree.query(xq, k=4)
+    unsure = dist[:, 3] > np.minimum(xq - lo, hi - xq).min(axis=1)  # a nearer particle may lie outside
+    if unsure.any():
+        dist[unsure] = cKDTree(x_all).query(xq[unsure], k=4)[0]
+    return dist[:, 1:].mean(axis=1)
 
 
 def loose_density_ceiling(x_all: np.ndarray, targets: np.ndarray, dx: float, rho0: float,
@@ -430,19 +450,21 @@ def loose_density_ceiling(x_all: np.ndarray, targets: np.ndarray, dx: float, rho
     """
     if len(targets) == 0:
         return np.zeros(0)
-    tree = cKDTree(x_all)
+    # one tree of the particles around the targets: the neighbourhoods (smoothing) and their three nearest
+    xt, r = x_all[targets], smoothing * dx
+    lo, hi = xt.min(axis=0) - r - 3 * dx, xt.max(axis=0) + r + 3 * dx
+    box = within_box(x_all, lo, hi)
+    tree = cKDTree(x_all[box])
     if smoothing > 0:
-        pairs = cKDTree(x_all[targets]).sparse_distance_matrix(tree, smoothing * dx, output_type="coo_matrix")
+        pairs = cKDTree(xt).sparse_distance_matrix(tree, r, output_type="ndarray")
         # d3 only of the particles some target averages over (not of the whole substrate); the pairs include
         # each target with itself (distance 0)
-        near, col = np.unique(pairs.col, return_inverse=True)
-        dist, _ = tree.query(x_all[near], k=4)
-        d3_near = np.minimum(dist[:, 1:].mean(axis=1), 3 * dx)
-        d3 = (np.bincount(pairs.row, d3_near[col], len(targets))
-              / np.bincount(pairs.row, minlength=len(targets)))
+        near, col = np.unique(pairs["j"], return_inverse=True)
+        d3_near = np.minimum(mean_nearest3(x_all, x_all[box[near]], lo, hi, tree), 3 * dx)
+        d3 = (np.bincount(pairs["i"], d3_near[col], len(targets))
+              / np.bincount(pairs["i"], minlength=len(targets)))
     else:
-        dist, _ = tree.query(x_all[targets], k=4)
-        d3 = dist[:, 1:].mean(axis=1)  # inf where fewer than three neighbours exist
+        d3 = mean_nearest3(x_all, xt, lo, hi, tree)  # inf where fewer than three neighbours exist
     with np.errstate(divide="ignore"):
         ceiling = np.maximum(rho0 * (d_ref * dx / d3) ** 3, rho_min)
     if smoothing > 0:
@@ -721,6 +743,7 @@ class BeadRun:
         # rho0 and a loose liquid's pressure already falls with its continuity density
         self.loose_ceiling = bool(params["loose_melt_ceiling"]) and self.num.cohesion is not None
         self.height_function = self.num.height_function
+        self.wire_key: tuple = ()  # the unmelted wire's ids and feed slice at the last connectivity search
 
     # ---- setup
     def open(self, resume: bool) -> None:
@@ -1172,7 +1195,15 @@ class BeadRun:
         if len(gid) == 0:
             return
         s = (pos - np.array([g.beam_x(self.state.t), 0.0, g.wire_height])) @ g.wire_axis
-        cut = scene.detached_wire(pos, s, self.state.wire_s_last, scene.wire_link_length(g))
+        link = scene.wire_link_length(g)
+        # The solid wire moves rigidly, so its connectivity changes only when its particles do (a particle
+        # melted, released or fed in) or the feed slice does. The same key as last chunk: nothing was cut then
+        # (it would have been released since), so nothing is now (saves the pair search, ~2 % of a bead run).
+        key = (gid.tobytes(), (s >= self.state.wire_s_last - 0.5 * link).tobytes())
+        if key == self.wire_key:
+            return
+        self.wire_key = key
+        cut = scene.detached_wire(pos, s, self.state.wire_s_last, link)
         if cut.any():
             self.per_id.released[gid[cut]] = True
             if self.rank0:
