@@ -366,8 +366,14 @@ def test_loose_drop_stays_loose_unless_its_density_is_capped(ceiling):
 
 def test_smoothed_ceiling_compacts_a_loose_drop_and_leaves_a_dense_one():
     """The smoothed ceiling (threshold 0.985 dx, d3 averaged within 1.5 dx; same drops as above) compacts the
-    drop cut at 1.2 dx to 1.00 (measured; 0.98 with the first form) and leaves a drop cut at dx as it is
-    without any ceiling (measured 0.965 and 74 deg both; the first form compacts it to 0.93)."""
+    drop cut at 1.2 dx to 1.00 (measured; 0.98 with the first form) and leaves a drop cut at dx within the
+    scatter of the drop without any ceiling.
+
+    That scatter is wide: the drop starts on an exact lattice, and where it ends at 0.06 s depends on rounding
+    (measured 2026-12-05 over starts at 0.999 / 1.0005 / 1.001 / 1.002 dx: 0.946-0.981 without a ceiling,
+    0.950-0.963 smoothed, 0.919-0.951 with the first form; the smoothed drop cut at exactly dx read 0.922-0.965
+    with the ceiling's pair sums taken in five different orders). So the dense drop is held to 0.045 of the
+    uncapped one, not to the 0.015 that one sample once suggested."""
     drop = functools.partial(vt.sessile_drop, TI, wetting_ratio=0.8, radius=2.4e-3, plate_half_width=4.4e-3,
                              plate_layers=3, gravity=9.81, t_end=0.06, t_average=1e-3)
     settings = functools.partial(vt.SceneSettings, dx=4e-4, c0=4.15, alpha=0.2, dt=10.8e-6, pressure_balance=True)
@@ -376,7 +382,7 @@ def test_smoothed_ceiling_compacts_a_loose_drop_and_leaves_a_dense_one():
     assert 0.95 < loose["packing_ratio"] < 1.04
     dense = drop(initial_spacing=1.0, settings=smoothed)
     free = drop(initial_spacing=1.0, settings=settings(loose_ceiling=False))
-    assert dense["packing_ratio"] == pytest.approx(free["packing_ratio"], abs=0.015)
+    assert dense["packing_ratio"] == pytest.approx(free["packing_ratio"], abs=0.045)
 
 
 @pytest.mark.parametrize("ceiling", [False, True])
