@@ -68,7 +68,10 @@ def test_smoothed_loose_melt_ceiling_on_two_ranks(tmp_path):
     """The smoothed loose-melt ceiling averages d3 over particles up to 1.5 dx from a melt particle, each needing
     its three nearest neighbours: the deck extends the ghosts' reach (comm_modify cutoff 3.7 dx), and 1 and 2
     ranks agree as above (measured at 0.25 s: boiled-off energy 0.05 %, late melt count 0.8 %, stored energy
-    0.5 % apart)."""
+    0.5 % apart). The ceiling's cap switches on where a neighbourhood's mean d3 crosses the threshold, so the
+    order in which sums are rounded moves the run: at 0.2 s the stored energy read 226.4 / 224.4 J (1 / 2 ranks)
+    with the ceiling's sums in one order and 228.3 / 225.3 J in another (2026-12-05), while a preheat 1e-6 K
+    higher changed it by 3e-7 J; so 2.5 %, not 1 %."""
     params = small_case(sim_time_s=0.2, surface_tension=True, artificial_viscosity=0.2,
                         wetting_pressure_balance=True, wetting_angle_deg=72.7, resolidified_density="freeze",
                         density_tolerance=0.5, loose_melt_ceiling=True, loose_melt_d3=0.985,
@@ -81,7 +84,7 @@ def test_smoothed_loose_melt_ceiling_on_two_ranks(tmp_path):
     series = [xr.load_dataset(tmp_path / name / "timeseries.nc") for name in ("one", "two")]
     late = [s["n_liquid"].where(s["t"] > 0.1).mean().item() for s in series]
     assert late[0] > 20 and late[1] == pytest.approx(late[0], rel=0.10)
-    assert series[1]["E_internal"][-1].item() == pytest.approx(series[0]["E_internal"][-1].item(), rel=0.01)
+    assert series[1]["E_internal"][-1].item() == pytest.approx(series[0]["E_internal"][-1].item(), rel=0.025)
 
 
 @pytest.mark.mpi
