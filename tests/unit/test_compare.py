@@ -63,6 +63,13 @@ def test_error_table_gives_the_run_means_beside_the_last_sections(experiments):
         assert ax.get_ylim()[1] >= t.loc["sph_run", f"{q}_run_mean_mm"] + sd
     assert np.isnan(t.loc["reduced_run", "width_run_mean_mm"]) and np.isnan(t.loc["reduced_run",
                                                                                   "height_run_mean_err_rel"])
+    # like with like: the SPH run carries what its measure reads for Table 1's bead at its spacing (dx 0.4: a
+    # 1.0 mm cap stacked on the plate's layers reads two layers, 0.8 mm); the reduced model has no particles
+    assert t.loc["sph_run", "height_lattice_registered_mm"] == pytest.approx(0.8)
+    assert t.loc["sph_run", "width_lattice_lo_mm"] <= t.loc["sph_run", "width_lattice_random_mm"] < w
+    assert t.loc["reduced_run", ["width_lattice_random_mm", "height_lattice_hi_mm"]].isna().all()
+    for ax in fig.axes:  # one band per SPH spacing
+        assert sum("read by the measure" in lab for lab in ax.get_legend_handles_labels()[1]) == 1
     # a dataset of reduced runs only has no run-mean variables at all
     t = error_table(ds.drop_vars(["bead_width_run_mean_mm", "bead_height_run_mean_mm", "bead_width_run_sd_mm",
                                   "bead_height_run_sd_mm"]), experiments)

@@ -19,6 +19,7 @@ from beadsim.sph.surface import (
     bead_cross_section,
     height_map,
     isotherm_extent,
+    lattice_cap_readings,
     lattice_phase,
     penetration_depth,
     pool_geometry,
@@ -261,3 +262,23 @@ def test_isotherm_extent_of_an_analytic_field(shift):
     assert ext["width_mm"] == pytest.approx(2 * b * scale * 1e3, rel=0.03)
     assert ext["length_mm"] == pytest.approx(2 * a * scale * 1e3, rel=0.03)
     assert isotherm_extent(pos, temp, 2 * t_peak, dx) == {"width_mm": 0.0, "length_mm": 0.0}
+
+
+def test_lattice_cap_readings_of_a_known_bead():
+    """The measure applied to a cap filled with particles. Stacked on the plate's layers (centres at dx/2,
+    3 dx/2, ...) a cap of height H reads n dx, n the number of layer centres below H: a 3.3 x 0.9 mm cap reads
+    0.8 mm at dx 0.4 (two layers) and 0.9 mm at dx 0.3 (three). Over random phases the top centre lies anywhere
+    within dx below H, so the mean reading is H within a fraction of dx; the width reads low (a bin counts
+    only where a whole particle fits under the cap). All of it vanishes as dx shrinks."""
+    w, h = 3.3e-3, 0.9e-3
+    for dx, n_layers in ((0.4e-3, 2), (0.3e-3, 3)):
+        r = lattice_cap_readings(w, h, dx)
+        assert r["height_registered_mm"] == pytest.approx(n_layers * dx * 1e3)
+        assert r["height_random_mm"] == pytest.approx(h * 1e3, abs=0.25 * dx * 1e3)
+        assert r["height_lo_mm"] >= (h - dx) * 1e3 - 1e-9 and r["height_hi_mm"] <= (h + 0.5 * dx) * 1e3 + 1e-9
+        assert r["width_lo_mm"] <= r["width_random_mm"] < w * 1e3
+        assert w * 1e3 - r["width_random_mm"] < 2 * dx * 1e3
+    fine = lattice_cap_readings(w, h, 0.05e-3)
+    for key in ("registered", "random"):
+        assert fine[f"height_{key}_mm"] == pytest.approx(h * 1e3, rel=0.03)
+        assert fine[f"width_{key}_mm"] == pytest.approx(w * 1e3, rel=0.02)

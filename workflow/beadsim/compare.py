@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -9,6 +10,7 @@ import pandas as pd
 import xarray as xr
 
 from beadsim.reduced import cap_area
+from beadsim.sph.surface import lattice_cap_readings
 from beadsim.study import EXPERIMENT_PARAMS
 
 
@@ -102,9 +104,32 @@ def error_table(ds: xr.Dataset, exp: pd.DataFrame) -> pd.DataFrame:
                 run = f"bead_{q}_run_{stat}_mm"
                 row[f"{q}_run_{stat}_mm"] = float(ds[run].values[i]) if run in ds else np.nan
             row[f"{q}_run_mean_err_rel"] = (row[f"{q}_run_mean_mm"] - meas) / meas
+        row.update(lattice_reading(exp.loc[mode], row["model"], row["resolution_mm"]))
         rows.append(row)
     cols = ["run_id", "mode", "model", "resolution_mm", "status", "measured_mass_consistent"] + [
         f"{q}_{s}" for q in ("width", "height")
         for s in ("pred_mm", "meas_mm", "unc_mm", "err_mm", "err_rel", "run_mean_mm", "run_sd_mm",
-                  "run_mean_err_rel")]
+                  "run_mean_err_rel") + LATTICE_READINGS]
     return pd.DataFrame(rows, columns=cols)
+
+
+#: Columns of :func:`lattice_reading` (after ``width_`` / ``height_``)
+LATTICE_READINGS = ("lattice_registered_mm", "lattice_random_mm", "lattice_lo_mm", "lattice_hi_mm")
+
+
+@functools.lru_cache(maxsize=64)
+def _lattice_cap(width_mm: float, height_mm: float, dx_mm: float) -> dict:
+    return lattice_cap_readings(width_mm * 1e-3, height_mm * 1e-3, dx_mm * 1e-3)
+
+
+def lattice_reading(measured: pd.Series, model: str, dx_mm: float) -> dict:
+    """What the SPH bead measure reads at the run's spacing for the measured bead itself (a circular cap of
+    Table 1's width and height filled with particles, :func:`beadsim.sph.surface.lattice_cap_readings`): with
+    the cap's layers on the plate's (``*_lattice_registered_mm``), over random lattice phases
+    (``*_lattice_random_mm``) and the band of both (``*_lattice_lo_mm`` to ``*_lattice_hi_mm``). A run is
+    compared like with like against these; NaN for models without particles."""
+    names = [f"{q}_{s}" for q in ("width", "height") for s in LATTICE_READINGS]
+    if model != "sph" or not np.isfinite(dx_mm) or dx_mm <= 0:
+        return dict.fromkeys(names, np.nan)
+    r = _lattice_cap(float(measured["bead_width_mm"]), float(measured["bead_height_mm"]), float(dx_mm))
+    return {f"{q}_{s}": r[f"{q}_{s.removeprefix('lattice_')}"] for q in ("width", "height") for s in LATTICE_READINGS}

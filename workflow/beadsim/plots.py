@@ -264,6 +264,16 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
         for k, ((model, res), grp) in enumerate(errors.groupby(["model", "resolution_mm"])):
             ok = grp[grp["status"] == "ok"]
             name = model if model == "reduced" else f"{model} dx={res:g} mm"
+            band = grp.drop_duplicates("mode").dropna(subset=[f"{q}_lattice_lo_mm"]) \
+                if f"{q}_lattice_lo_mm" in grp else grp.iloc[:0]
+            if len(band):
+                # the measured bead as the particle measure reads it at this spacing: a bar over the band of
+                # lattice phases, dots at the registered and the random-phase means (left of the measured value)
+                xb = band[f"{q}_meas_mm"] - 0.015 * (k + 1) * lim[1]
+                ax.vlines(xb, band[f"{q}_lattice_lo_mm"], band[f"{q}_lattice_hi_mm"], color=f"C{k}", lw=4,
+                          alpha=0.3, label=f"measured bead read by the measure at dx={res:g} mm")
+                ax.plot(xb, band[f"{q}_lattice_registered_mm"], "_", color=f"C{k}", ms=9)
+                ax.plot(xb, band[f"{q}_lattice_random_mm"], ".", color=f"C{k}", ms=5)
             for consistent, part in ok.groupby("measured_mass_consistent"):
                 ax.errorbar(part[f"{q}_meas_mm"], part[f"{q}_pred_mm"], xerr=part[f"{q}_unc_mm"], fmt="o",
                             color=f"C{k}", mfc=None if consistent else "none",
