@@ -338,7 +338,8 @@ def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_s
         if i % 2:
             yi, hi = np.concatenate([[yi[0] - dx], yi]), np.concatenate([[np.nan], h])
         section = {"mass_balance_ratio": ratio, "penetration_depth_mm": 0.1 * i, "fusion_width_mm": 3.0,
-                   **surface.profile_metrics(y, h, dx), "profile": (yi, hi)}
+                   **surface.profile_metrics(y, h, dx), "profile": (yi, hi),
+                   "bead_top_phase": 0.45 * (-1) ** i, "bead_top_order": 0.1 * i}
         monkeypatch.setattr(run, "_bead_metrics", lambda supply, s=section: dict(s))
         run.series.append({"t": 0.05 * (i + 1), **run._bead_check()})
     m = run._metrics()
@@ -354,6 +355,9 @@ def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_s
     assert m["bead_width_sd_mm"] == pytest.approx(np.std(widths, ddof=1), rel=1e-12) and m["bead_width_sd_mm"] > 0
     assert m["bead_height_sd_mm"] == pytest.approx(np.std(heights, ddof=1), rel=1e-9)
     assert m["mass_balance_sd"] == pytest.approx(np.std(ratios[last], ddof=1), rel=1e-12)
+    # the tops' phase is circular: sections at +0.45 and -0.45 spacings average to half a spacing, not to 0
+    assert abs(m["bead_top_phase"]) == pytest.approx(0.5, abs=0.05)
+    assert m["bead_top_order"] == pytest.approx(np.mean([0.1 * i for i in range(6)][last]), rel=1e-12)
     # the run means: every section since the wire's metal arrived (the first mass balance >= 1 - steady_tolerance:
     # 1.3 at 0.10 s), the mean over the humps
     since = slice(1, None)

@@ -23,6 +23,7 @@ from beadsim.sph.surface import (
     lattice_phase,
     penetration_depth,
     pool_geometry,
+    top_layer_registration,
 )
 
 DX = 1e-4  # m
@@ -282,3 +283,17 @@ def test_lattice_cap_readings_of_a_known_bead():
     for key in ("registered", "random"):
         assert fine[f"height_{key}_mm"] == pytest.approx(h * 1e3, rel=0.03)
         assert fine[f"width_{key}_mm"] == pytest.approx(w * 1e3, rel=0.02)
+
+
+def test_top_layer_registration():
+    """Tops stacked on the plate's layers read phase 0 and order 1; a cap lifted by a third of a spacing reads
+    phase 1/3; tops at every height (jittered by a whole spacing) read an order near 0."""
+    pos = bead_cloud(60.0)  # lattice cells centred at (k + 1/2) DX: the cap continues the plate's layers
+    phase, order = top_layer_registration(pos, DX, WINDOW)
+    assert phase == pytest.approx(0.0, abs=1e-9) and order == pytest.approx(1.0)
+    lifted = pos + np.where(pos[:, 2:] > 0, DX / 3, 0.0) * np.array([0.0, 0.0, 1.0])
+    assert top_layer_registration(lifted, DX, WINDOW) == pytest.approx((1 / 3, 1.0))
+    rng = np.random.default_rng(3)
+    shaken = pos + np.where(pos[:, 2:] > 0, rng.uniform(0, DX, (len(pos), 1)), 0.0) * np.array([0.0, 0.0, 1.0])
+    assert top_layer_registration(shaken, DX, WINDOW)[1] < 0.3
+    assert np.isnan(top_layer_registration(pos[pos[:, 2] < 0], DX, WINDOW)[1])  # a bare plate has no tops

@@ -29,6 +29,11 @@ METRICS: dict[str, tuple[str, str]] = {
     "bead_run_from_s": ("s", "time of the first cross-section carrying the wire's metal (mass balance within "
                         "steady_tolerance of 1; SPH window)"),
     "bead_run_sections": ("1", "cross-sections in the run means (SPH window)"),
+    "bead_top_phase": ("1", "where the bead's column tops sit between the plate's layers continued upwards, "
+                       "circular mean in spacings (0: on a layer; SPH)"),
+    "bead_top_order": ("1", "how closely the bead's column tops keep one phase: 1 stacked on one phase of the "
+                       "layers, near 0 at every height (resultant length; SPH; which reading of the measured "
+                       "bead it compares with: registered near 1, random near 0)"),
     "aspect_ratio": ("1", "bead height / width"),
     "contact_angle_deg": ("degree", "bead contact angle"),
     "penetration_depth_mm": ("mm", "remelt depth into substrate"),

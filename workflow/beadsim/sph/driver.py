@@ -1585,7 +1585,7 @@ class BeadRun:
     def _bead_check(self) -> dict:
         """Bead cross-section now (moving window), for the steady-state test and the final average."""
         keys = ("bead_width_mm", "bead_height_mm", "bead_area_mm2", "contact_angle_deg", "mass_balance_ratio",
-                "penetration_depth_mm", "fusion_width_mm") + POOL_KEYS
+                "penetration_depth_mm", "fusion_width_mm", "bead_top_phase", "bead_top_order") + POOL_KEYS
         out = self._bead_metrics(self._supply_mm2())
         if "profile" in out:
             self.profiles = (self.profiles + [out["profile"]])[-int(self.p["bead_sections"]):]
@@ -1793,8 +1793,11 @@ class BeadRun:
             checks = sections[-int(p["bead_sections"]):]
             if self.geom.moving_window and checks and self.profiles:
                 # the mean of the last bead_sections cross-sections (0.05 s apart; three by default)
-                for key in ("mass_balance_ratio", "penetration_depth_mm", "fusion_width_mm"):
+                for key in ("mass_balance_ratio", "penetration_depth_mm", "fusion_width_mm", "bead_top_order"):
                     out[key] = float(np.nanmean([c.get(key, np.nan) for c in checks]))
+                phases = _finite_values(checks, "bead_top_phase")
+                out["bead_top_phase"] = (float((np.angle(np.exp(2j * np.pi * phases).mean()) / (2 * np.pi) + 0.5)
+                                               % 1.0 - 0.5) if len(phases) else np.nan)
                 for key, sd_key in SECTION_SPREAD.items():
                     out[sd_key] = _sample_sd(_finite_values(checks, key))
                 out["bead_samples"] = len(checks)
@@ -1893,6 +1896,7 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
     y_bins, top = surface.height_map(x[deposit], geom.dx, window, z_surface=0.0)
     out.update(surface.profile_metrics(y_bins, top, geom.dx))
     out["profile"] = (y_bins, top)
+    out["bead_top_phase"], out["bead_top_order"] = surface.top_layer_registration(x[deposit], geom.dx, window)
     out["penetration_depth_mm"] = surface.penetration_depth(x, melted, geom.dx, window, z_surface=0.0)
     out["fusion_width_mm"] = surface.fusion_width(x[deposit], melted[deposit], geom.dx, window, z_surface=0.0)
     if out.get("bead_width_mm"):

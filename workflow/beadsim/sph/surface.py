@@ -239,6 +239,29 @@ def profile_metrics(y: np.ndarray, h: np.ndarray, dx: float) -> dict:
     }
 
 
+def top_layer_registration(pos, dx, x_window, z_surface=0.0, mask=None) -> tuple[float, float]:
+    """Where the bead's column tops sit relative to the plate's layers: which reading of
+    :func:`lattice_cap_readings` a bead compares with.
+
+    Over the (x, y) columns of the window whose highest particle centre lies above the surface
+    (``z > z_surface``), the phase ``(z_top - z_surface) / dx - 1/2`` modulo 1 (0: on one of the plate's layers
+    continued upwards, centres at ``dx/2``, ``3 dx/2``, ...). Returns the circular mean phase in
+    ``[-0.5, 0.5)`` and the resultant length in ``[0, 1]``: 1 for tops stacked exactly on the plate's layers,
+    near 0 for tops at every height (NaN, NaN without such columns).
+    """
+    pos = np.asarray(pos, dtype=float).reshape(-1, 3)
+    inside = _window(pos, x_window)
+    if not inside.any():
+        return float("nan"), float("nan")
+    table, _, _ = _column_table(pos[inside], dx, None if mask is None else np.asarray(mask, dtype=bool)[inside],
+                                pos[inside, 2] - z_surface, np.maximum)
+    tops = table[np.isfinite(table) & (table > 0.0)]
+    if len(tops) == 0:
+        return float("nan"), float("nan")
+    mean = np.exp(2j * np.pi * (tops / dx - 0.5)).mean()
+    return float((np.angle(mean) / (2 * np.pi) + 0.5) % 1.0 - 0.5), float(abs(mean))
+
+
 def lattice_cap_readings(width: float, height: float, dx: float, n_phases: int = 32, seed: int = 0) -> dict:
     """What :func:`bead_cross_section` reads at spacing ``dx`` for a bead whose cross-section is a circular
     cap of base ``width`` and ``height`` (m): the measure applied to the cap filled with particles.
