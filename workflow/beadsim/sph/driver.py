@@ -1796,8 +1796,7 @@ class BeadRun:
                 for key in ("mass_balance_ratio", "penetration_depth_mm", "fusion_width_mm", "bead_top_order"):
                     out[key] = float(np.nanmean([c.get(key, np.nan) for c in checks]))
                 phases = _finite_values(checks, "bead_top_phase")
-                out["bead_top_phase"] = (float((np.angle(np.exp(2j * np.pi * phases).mean()) / (2 * np.pi) + 0.5)
-                                               % 1.0 - 0.5) if len(phases) else np.nan)
+                out["bead_top_phase"] = surface.circular_phase_mean(phases)[0] if len(phases) else np.nan
                 for key, sd_key in SECTION_SPREAD.items():
                     out[sd_key] = _sample_sd(_finite_values(checks, key))
                 out["bead_samples"] = len(checks)

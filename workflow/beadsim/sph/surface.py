@@ -258,7 +258,12 @@ def top_layer_registration(pos, dx, x_window, z_surface=0.0, mask=None) -> tuple
     tops = table[np.isfinite(table) & (table > 0.0)]
     if len(tops) == 0:
         return float("nan"), float("nan")
-    mean = np.exp(2j * np.pi * (tops / dx - 0.5)).mean()
+    return circular_phase_mean(tops / dx - 0.5)
+
+
+def circular_phase_mean(phases) -> tuple[float, float]:
+    """Circular mean (in ``[-0.5, 0.5)``) and resultant length (in ``[0, 1]``) of phases given in cycles."""
+    mean = np.exp(2j * np.pi * np.asarray(phases, dtype=float)).mean()
     return float((np.angle(mean) / (2 * np.pi) + 0.5) % 1.0 - 0.5), float(abs(mean))
 
 
@@ -273,7 +278,7 @@ def lattice_cap_readings(width: float, height: float, dx: float, n_phases: int =
     ``3 dx/2``, ... above the surface, as melt stacked on a frozen lattice sits), y phases
     ``(k + 0.5) / n_phases``; *random*: ``n_phases`` phases uniform in y and in z. The readings differ from the
     cap's width and height because only whole particles stand for it: at dx 0.4 mm a 3.3 x 1.0 mm cap reads
-    0.80 mm high registered (two layers) and 0.80-1.19 mm over random phases.
+    0.80 mm high registered (two layers) and 0.80-1.17 mm over random phases (1.01 on average).
 
     Returns
     -------
