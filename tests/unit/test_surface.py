@@ -279,6 +279,8 @@ def test_lattice_cap_readings_of_a_known_bead():
         assert r["height_lo_mm"] >= (h - dx) * 1e3 - 1e-9 and r["height_hi_mm"] <= (h + 0.5 * dx) * 1e3 + 1e-9
         assert r["width_lo_mm"] <= r["width_random_mm"] < w * 1e3
         assert w * 1e3 - r["width_random_mm"] < 2 * dx * 1e3
+    with pytest.raises(ValueError, match="positive width, height and dx"):
+        lattice_cap_readings(w, 0.0, 0.4e-3)
     fine = lattice_cap_readings(w, h, 0.05e-3)
     for key in ("registered", "random"):
         assert fine[f"height_{key}_mm"] == pytest.approx(h * 1e3, rel=0.03)

@@ -287,6 +287,8 @@ def lattice_cap_readings(width: float, height: float, dx: float, n_phases: int =
         ``height_random_mm`` (means over the random phases), ``width_lo_mm``, ``width_hi_mm``, ``height_lo_mm``,
         ``height_hi_mm`` (extremes over both sets: the band a bead of exactly this shape can read).
     """
+    if not (width > 0 and height > 0 and dx > 0):
+        raise ValueError(f"lattice_cap_readings needs a positive width, height and dx (got {width}, {height}, {dx} m)")
     radius = (width**2 / 4 + height**2) / (2 * height)
     z_centre = height - radius
     n_x = 5
