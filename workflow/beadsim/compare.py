@@ -129,7 +129,8 @@ def lattice_reading(measured: pd.Series, model: str, dx_mm: float) -> dict:
     (``*_lattice_random_mm``) and the band of both (``*_lattice_lo_mm`` to ``*_lattice_hi_mm``). A run is
     compared like with like against these; NaN for models without particles."""
     names = [f"{q}_{s}" for q in ("width", "height") for s in LATTICE_READINGS]
-    if model != "sph" or not np.isfinite(dx_mm) or dx_mm <= 0:
+    width, height = float(measured["bead_width_mm"]), float(measured["bead_height_mm"])
+    if model != "sph" or not all(np.isfinite(v) and v > 0 for v in (dx_mm, width, height)):
         return dict.fromkeys(names, np.nan)
-    r = _lattice_cap(float(measured["bead_width_mm"]), float(measured["bead_height_mm"]), float(dx_mm))
+    r = _lattice_cap(width, height, float(dx_mm))
     return {f"{q}_{s}": r[f"{q}_{s.removeprefix('lattice_')}"] for q in ("width", "height") for s in LATTICE_READINGS}
