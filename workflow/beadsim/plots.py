@@ -269,7 +269,9 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
             if len(band):
                 # the measured bead as the particle measure reads it at this spacing: a bar over the band of
                 # lattice phases, dots at the registered and the random-phase means (left of the measured value)
-                xb = band[f"{q}_meas_mm"] - 0.015 * (k + 1) * lim[1]
+                # modes measured alike (modes 2 and 3: 3.6 mm wide) side by side, not on top of each other
+                alike = band.groupby(f"{q}_meas_mm").cumcount()
+                xb = band[f"{q}_meas_mm"] - (0.015 * (k + 1) + 0.01 * alike) * lim[1]
                 ax.vlines(xb, band[f"{q}_lattice_lo_mm"], band[f"{q}_lattice_hi_mm"], color=f"C{k}", lw=4,
                           alpha=0.3, label=f"measured bead read by the measure at dx={res:g} mm")
                 ax.plot(xb, band[f"{q}_lattice_registered_mm"], "_", color=f"C{k}", ms=9)
