@@ -22,11 +22,15 @@ import numpy as np
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
+def circular_phase_mean(phases) -> tuple[float, float]:
+    """Circular mean (in ``[-0.5, 0.5)``) and resultant length (in ``[0, 1]``) of phases given in cycles."""
+    mean = np.exp(2j * np.pi * np.asarray(phases, dtype=float)).mean()
+    return float((np.angle(mean) / (2 * np.pi) + 0.5) % 1.0 - 0.5), float(abs(mean))
+
+
 def lattice_phase(values: np.ndarray, dx: float) -> float:
     """Offset of a (possibly jittered) lattice: circular mean of ``values / dx`` modulo 1, in ``[0, 1)``."""
-    angle = 2.0 * np.pi * np.asarray(values, dtype=float) / dx
-    phase = np.arctan2(np.sin(angle).mean(), np.cos(angle).mean()) / (2.0 * np.pi)
-    return float(phase % 1.0)
+    return circular_phase_mean(np.asarray(values, dtype=float) / dx)[0] % 1.0
 
 
 def bin_index(values: np.ndarray, dx: float, phase: float) -> np.ndarray:
@@ -260,11 +264,6 @@ def top_layer_registration(pos, dx, x_window, z_surface=0.0, mask=None) -> tuple
         return float("nan"), float("nan")
     return circular_phase_mean(tops / dx - 0.5)
 
-
-def circular_phase_mean(phases) -> tuple[float, float]:
-    """Circular mean (in ``[-0.5, 0.5)``) and resultant length (in ``[0, 1]``) of phases given in cycles."""
-    mean = np.exp(2j * np.pi * np.asarray(phases, dtype=float)).mean()
-    return float((np.angle(mean) / (2 * np.pi) + 0.5) % 1.0 - 0.5), float(abs(mean))
 
 
 def lattice_cap_readings(width: float, height: float, dx: float, n_phases: int = 32, seed: int = 0) -> dict:
