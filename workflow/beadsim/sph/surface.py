@@ -47,13 +47,13 @@ def _column_table(pos, dx, keep, stat, reducer):
     """Per-(x, y)-column reduction of a per-particle value on lattice-aligned bins of width ``dx``.
 
     The grid of columns is set by all particles ``pos``; only those flagged by ``keep`` (None: all) feed the
-    reduction. Returns the table (nx, ny), ``-inf`` (``np.maximum``) or ``+inf`` (``np.minimum``) where a
-    column is empty, and the x and y bin centres (m).
+    reduction. Returns the table (nx, ny), ``-inf`` (``np.maximum``), ``+inf`` (``np.minimum``) or 0
+    (``np.add``) where a column is empty, and the x and y bin centres (m).
     """
     phase_x, phase_y = lattice_phase(pos[:, 0], dx), lattice_phase(pos[:, 1], dx)
     ix, iy = bin_index(pos[:, 0], dx, phase_x), bin_index(pos[:, 1], dx, phase_y)
     ix0, iy0 = ix.min(), iy.min()
-    fill = -np.inf if reducer is np.maximum else np.inf
+    fill = {np.maximum: -np.inf, np.minimum: np.inf, np.add: 0.0}[reducer]
     table = np.full((ix.max() - ix0 + 1, iy.max() - iy0 + 1), fill)
     use = np.ones(len(pos), dtype=bool) if keep is None else np.asarray(keep, dtype=bool)
     reducer.at(table, (ix[use] - ix0, iy[use] - iy0), np.asarray(stat, dtype=float)[use])
@@ -132,6 +132,59 @@ def height_map(pos, dx, x_window, z_surface=0.0, mask=None):
     top = top - z_surface
     top[~np.isfinite(top)] = np.nan
     return y_centres, top
+
+
+def mass_height_profile(pos, dx, x_window, z_base, z_surface=0.0, mask=None):
+    """Height the material of each y bin reaches at the lattice's density: the particles above ``z_base`` per
+    (x, y) column times ``dx``, averaged over the x columns of the window, on :func:`height_map`'s bins.
+
+    :func:`height_map` reads a surface from the highest particle of each column, which is exact for particles
+    stacked in columns (a lattice) but low for a disordered one, whose top particles sit off their columns'
+    centres and leave some columns a particle short: in the SPH beads (mode 1, dx 0.4 mm, 39 sections over
+    2-4 s) the map's areas were 0.87 of these and its peak heights 0.91 (both as :func:`smoothed_peak`), while
+    the frozen melt inside the bead was no denser than the lattice (Voronoi cells of 1.00-1.07 dx^3). This
+    profile counts mass instead, so its area is the section's mass by construction; it says nothing about
+    where the contact line lies.
+
+    Parameters
+    ----------
+    pos, dx, x_window, z_surface, mask
+        As for :func:`height_map` (the grid of columns is set by all particles in the window).
+    z_base : float, m
+        A plane below every change of the material (the block's bottom face): each column holds the
+        undisturbed lattice between it and the melted zone.
+
+    Returns
+    -------
+    y_centres : (ny,) array, m
+    height : (ny,) array, m
+        ``z_base`` + (particles per column) ``dx`` - ``z_surface``, averaged over the x columns but the first
+        and last (which the window cuts) where there are three or more.
+    """
+    pos = np.asarray(pos, dtype=float).reshape(-1, 3)
+    inside = _window(pos, x_window)
+    if not inside.any():
+        return np.empty(0), np.empty(0)
+    keep = pos[inside, 2] >= z_base
+    if mask is not None:
+        keep &= np.asarray(mask, dtype=bool)[inside]
+    table, _, y_centres = _column_table(pos[inside], dx, keep, np.ones(int(inside.sum())), np.add)
+    if table.shape[0] >= 3:
+        table = table[1:-1]
+    return y_centres, z_base + table.mean(axis=0) * dx - z_surface
+
+
+def smoothed_peak(h: np.ndarray) -> float:
+    """Highest value of a profile after a (1, 2, 1) / 4 running mean over its bins (missing bins count as 0):
+    the height of :func:`mass_height_profile`, whose single bins scatter by about a third of a spacing in the
+    SPH beads (a column holds a particle more or less; mode 1 at dx 0.4 mm, ~9 columns per bin: rms 0.29 dx
+    about a fitted circle). On circular caps 0.7-1.2 mm high on bins of 0.4 mm it reads 0.96-0.98 of the
+    height without scatter and 0.99-1.02 with a scatter of dx / 3, where the highest bin reads 1.09-1.15
+    (tests/unit/test_surface.py)."""
+    h = np.nan_to_num(np.asarray(h, dtype=float), nan=0.0)
+    if len(h) == 0:
+        return 0.0
+    return float(np.convolve(h, [0.25, 0.5, 0.25], mode="same").max())
 
 
 def _bead_run(top: np.ndarray, threshold: float) -> slice:
