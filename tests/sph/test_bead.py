@@ -279,6 +279,7 @@ def test_moving_window_conserves_energy_and_feeds_substrate(tmp_path):
     sections = ts.mass_balance_ratio.values[np.isfinite(ts.mass_balance_ratio.values)]
     assert m["bead_samples"] == 3 and m["mass_balance_ratio"] == pytest.approx(sections[-3:].mean(), rel=1e-12)
     assert 0 < m["bead_height_mm"] < 3 * params["wire_diameter_mm"] and m["bead_width_mm"] > 0
+    assert 0 < m["bead_height_mass_mm"] < 3 * params["wire_diameter_mm"]
     dump = sorted((tmp_path / "dumps").glob("*.lammpstrj"), key=lambda f: int(f.name.split(".")[1]))[-1]
     lines = dump.read_text().splitlines()
     start = next(i for i, line in enumerate(lines) if line.startswith("ITEM: ATOMS")) + 1
@@ -339,7 +340,8 @@ def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_s
             yi, hi = np.concatenate([[yi[0] - dx], yi]), np.concatenate([[np.nan], h])
         section = {"mass_balance_ratio": ratio, "penetration_depth_mm": 0.1 * i, "fusion_width_mm": 3.0,
                    **surface.profile_metrics(y, h, dx), "profile": (yi, hi),
-                   "bead_top_phase": 0.45 * (-1) ** i, "bead_top_order": 0.1 * i}
+                   "bead_top_phase": 0.45 * (-1) ** i, "bead_top_order": 0.1 * i,
+                   "bead_height_mass_mm": 1.1 * caps[i][1] * dx * 1e3}
         monkeypatch.setattr(run, "_bead_metrics", lambda supply, s=section: dict(s))
         run.series.append({"t": 0.05 * (i + 1), **run._bead_check()})
     m = run._metrics()
@@ -368,6 +370,10 @@ def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_s
     assert m["bead_height_run_mean_mm"] == pytest.approx(np.mean([hgt * dx * 1e3 for _, hgt in caps[since]]),
                                                          rel=1e-9)
     assert m["mass_balance_run_mean"] == pytest.approx(np.mean(ratios[since]), rel=1e-12)
+    mass_heights = [1.1 * hgt * dx * 1e3 for _, hgt in caps]
+    assert m["bead_height_mass_mm"] == pytest.approx(np.mean(mass_heights[last]), rel=1e-12)
+    assert m["bead_height_mass_run_mean_mm"] == pytest.approx(np.mean(mass_heights[since]), rel=1e-12)
+    assert m["bead_height_mass_run_sd_mm"] == pytest.approx(np.std(mass_heights[since], ddof=1), rel=1e-12)
     assert m["mass_balance_run_sd"] == pytest.approx(np.std(ratios[since], ddof=1), rel=1e-12)
     # stop_at_steady_state waits for bead_sections steady sections: the three that made it steady and later ones
     run.state.steady_time = 0.25  # steady with the sections at 0.15-0.25 s, one more taken since

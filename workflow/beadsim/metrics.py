@@ -22,6 +22,13 @@ METRICS: dict[str, tuple[str, str]] = {
                                 "(SPH window)"),
     "bead_height_run_sd_mm": ("mm", "bead height, standard deviation of the cross-sections since the wire's "
                               "metal arrived (SPH window)"),
+    "bead_height_mass_mm": ("mm", "bead height from the mass per column: peak of the (1, 2, 1) / 4 running mean "
+                            "of the particles counted per column at the lattice's density (SPH; mean of the "
+                            "averaged cross-sections in a window run)"),
+    "bead_height_mass_run_mean_mm": ("mm", "bead height from the mass per column, mean of the cross-sections since "
+                                     "the wire's metal arrived (SPH window)"),
+    "bead_height_mass_run_sd_mm": ("mm", "bead height from the mass per column, standard deviation of the "
+                                   "cross-sections since the wire's metal arrived (SPH window)"),
     "mass_balance_run_mean": ("1", "mass balance ratio, mean of the cross-sections since the wire's metal "
                               "arrived (SPH window)"),
     "mass_balance_run_sd": ("1", "mass balance ratio, standard deviation of the cross-sections since the wire's "

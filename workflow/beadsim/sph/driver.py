@@ -68,6 +68,7 @@ SECTION_SPREAD = {"bead_width_mm": "bead_width_sd_mm", "bead_height_mm": "bead_h
 #: within steady_tolerance of 1), with their standard deviations: for a bead that humps, the mean over the humps.
 RUN_MEANS = {"bead_width_mm": ("bead_width_run_mean_mm", "bead_width_run_sd_mm"),
              "bead_height_mm": ("bead_height_run_mean_mm", "bead_height_run_sd_mm"),
+             "bead_height_mass_mm": ("bead_height_mass_run_mean_mm", "bead_height_mass_run_sd_mm"),
              "mass_balance_ratio": ("mass_balance_run_mean", "mass_balance_run_sd")}
 
 
@@ -1585,7 +1586,8 @@ class BeadRun:
     def _bead_check(self) -> dict:
         """Bead cross-section now (moving window), for the steady-state test and the final average."""
         keys = ("bead_width_mm", "bead_height_mm", "bead_area_mm2", "contact_angle_deg", "mass_balance_ratio",
-                "penetration_depth_mm", "fusion_width_mm", "bead_top_phase", "bead_top_order") + POOL_KEYS
+                "penetration_depth_mm", "fusion_width_mm", "bead_top_phase", "bead_top_order",
+                "bead_height_mass_mm") + POOL_KEYS
         out = self._bead_metrics(self._supply_mm2())
         if "profile" in out:
             self.profiles = (self.profiles + [out["profile"]])[-int(self.p["bead_sections"]):]
@@ -1793,7 +1795,8 @@ class BeadRun:
             checks = sections[-int(p["bead_sections"]):]
             if self.geom.moving_window and checks and self.profiles:
                 # the mean of the last bead_sections cross-sections (0.05 s apart; three by default)
-                for key in ("mass_balance_ratio", "penetration_depth_mm", "fusion_width_mm", "bead_top_order"):
+                for key in ("mass_balance_ratio", "penetration_depth_mm", "fusion_width_mm", "bead_top_order",
+                            "bead_height_mass_mm"):
                     out[key] = float(np.nanmean([c.get(key, np.nan) for c in checks]))
                 phases = _finite_values(checks, "bead_top_phase")
                 out["bead_top_phase"] = surface.circular_phase_mean(phases)[0] if len(phases) else np.nan
@@ -1868,7 +1871,8 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
     The net added area (mass balance) counts every particle in the window slab minus the substrate particles
     it held at t = 0, so it is exact in mass; in the moving window (the lattice moves through the slab) it
     counts the particles that came from the wire (``wire_origin``). Width, height, contact angle, pool and
-    penetration come from :mod:`beadsim.sph.surface`.
+    penetration come from :mod:`beadsim.sph.surface`; ``bead_height_mass_mm`` from the particles counted per
+    column down to the block's bottom face (:func:`surface.mass_height_profile`).
     """
     out: dict = {}
     liquid = types == TYPE_LIQUID
@@ -1894,6 +1898,8 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
     out["mass_balance_ratio"] = net_area / supply_mm2 if supply_mm2 > 0 else np.nan  # no wire: undefined
     y_bins, top = surface.height_map(x[deposit], geom.dx, window, z_surface=0.0)
     out.update(surface.profile_metrics(y_bins, top, geom.dx))
+    mass = surface.mass_height_profile(x, geom.dx, window, geom.z_lo, mask=deposit)[1]
+    out["bead_height_mass_mm"] = max(surface.smoothed_peak(mass), 0.0) * 1e3 if len(mass) else np.nan
     out["profile"] = (y_bins, top)
     out["bead_top_phase"], out["bead_top_order"] = surface.top_layer_registration(x[deposit], geom.dx, window)
     out["penetration_depth_mm"] = surface.penetration_depth(x, melted, geom.dx, window, z_surface=0.0)
