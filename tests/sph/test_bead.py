@@ -280,6 +280,12 @@ def test_moving_window_conserves_energy_and_feeds_substrate(tmp_path):
     assert m["bead_samples"] == 3 and m["mass_balance_ratio"] == pytest.approx(sections[-3:].mean(), rel=1e-12)
     assert 0 < m["bead_height_mm"] < 3 * params["wire_diameter_mm"] and m["bead_width_mm"] > 0
     assert 0 < m["bead_height_mass_mm"] < 3 * params["wire_diameter_mm"]
+    # resumed at its end (a forced rerun of a finished run resumes from its last checkpoint), the run reports
+    # the same bead: the last sections' profiles are in the checkpoint, not only their scalar values
+    again = run_case(params, tmp_path, resume=True)
+    for key in ("bead_width_mm", "bead_height_mm", "bead_samples", "bead_width_run_mean_mm", "bead_height_mass_mm",
+                "bead_height_mass_run_mean_mm", "mass_balance_ratio", "contact_angle_deg"):
+        np.testing.assert_equal(again[key], m[key], err_msg=key)  # NaN (no run mean in so short a run) too
     dump = sorted((tmp_path / "dumps").glob("*.lammpstrj"), key=lambda f: int(f.name.split(".")[1]))[-1]
     lines = dump.read_text().splitlines()
     start = next(i for i, line in enumerate(lines) if line.startswith("ITEM: ATOMS")) + 1

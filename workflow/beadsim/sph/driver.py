@@ -1688,6 +1688,7 @@ class BeadRun:
                  face_area=self.per_id.face_area, wire_origin=self.per_id.wire_origin,
                  released=self.per_id.released, landed=self.per_id.landed,
                  series=json.dumps(self.series),
+                 profiles=json.dumps([[np.asarray(y).tolist(), np.asarray(h).tolist()] for y, h in self.profiles]),
                  particle_steps=self.particle_steps)
         os.replace(rdir / "state.tmp.npz", rdir / "state.npz")
         self._write_series()
@@ -1707,6 +1708,10 @@ class BeadRun:
             setattr(self.per_id, key, np.array(data[key]) if key in data else
                     np.zeros(len(self.per_id.max_t), dtype=bool))
         self.series = json.loads(str(data["series"]))
+        # the last sections' profiles, so that a run resumed near (or at) its end averages the same sections as
+        # the uninterrupted run (checkpoints from before they were kept: the sections taken after the resume)
+        self.profiles = [(np.array(y, dtype=float), np.array(h, dtype=float))
+                         for y, h in json.loads(str(data["profiles"]))] if "profiles" in data else []
         self.particle_steps = float(data["particle_steps"])
         # wall time, throughput and time shares cover the whole run, not only the resumed part
         self.t0_wall = time.perf_counter() - self.state.wall_s
