@@ -9,6 +9,7 @@ Run them with
 
 from __future__ import annotations
 
+import json
 import math
 import re
 
@@ -286,6 +287,17 @@ def test_moving_window_conserves_energy_and_feeds_substrate(tmp_path):
     for key in ("bead_width_mm", "bead_height_mm", "bead_samples", "bead_width_run_mean_mm", "bead_height_mass_mm",
                 "bead_height_mass_run_mean_mm", "mass_balance_ratio", "contact_angle_deg"):
         np.testing.assert_equal(again[key], m[key], err_msg=key)  # NaN (no run mean in so short a run) too
+    # the workflow resumes a killed run's checkpoint, not a finished run's (a forced rerun runs again)
+    from beadsim.runner import _can_resume
+
+    (tmp_path / "params.json").write_text(json.dumps({"run_id": "w", **params}))
+    assert not _can_resume(params, tmp_path)
+    with np.load(tmp_path / "restart" / "state.npz") as data:
+        saved = {k: data[k] for k in data.files}
+    state = json.loads(str(saved["state"]))
+    saved["state"] = json.dumps({**state, "finished": False})  # as a checkpoint taken before the end
+    np.savez(tmp_path / "restart" / "state.npz", **saved)
+    assert _can_resume(params, tmp_path)
     dump = sorted((tmp_path / "dumps").glob("*.lammpstrj"), key=lambda f: int(f.name.split(".")[1]))[-1]
     lines = dump.read_text().splitlines()
     start = next(i for i, line in enumerate(lines) if line.startswith("ITEM: ATOMS")) + 1

@@ -50,13 +50,23 @@ def run_model(params: dict, outdir: Path, materials_file=None, tasks: int = 1, m
 
 
 def _can_resume(params: dict, outdir: Path) -> bool:
-    """A killed SPH run left a checkpoint made with the same parameters: continue it instead of starting over."""
-    old = outdir / "params.json"
-    if not (outdir / "restart" / "state.npz").exists() or not old.exists():
+    """A killed SPH run left a checkpoint made with the same parameters: continue it instead of starting over.
+    A finished run's last checkpoint is not resumed: a forced rerun (snakemake deletes result.json first) is
+    meant to run again, with the code as it is now."""
+    old, state = outdir / "params.json", outdir / "restart" / "state.npz"
+    if not state.exists() or not old.exists():
         return False
     previous = json.loads(old.read_text())
     previous.pop("run_id", None)
-    return previous == json.loads(json.dumps(params))
+    if previous != json.loads(json.dumps(params)):
+        return False
+    import numpy as np
+
+    with np.load(state) as data:
+        finished = json.loads(str(data["state"])).get("finished", False)
+    if finished:
+        log.info("the checkpoint in %s is a finished run's: starting over", outdir / "restart")
+    return not finished
 
 
 def run_case(params: dict, outdir: str | Path, run_id: str = "", materials_file=None, tasks: int = 1,

@@ -675,6 +675,7 @@ class RunState:
     wall_s: float = 0.0  # wall, LAMMPS and bead-check time up to the checkpoint (a resumed run counts on)
     lammps_s: float = 0.0
     bead_s: float = 0.0
+    finished: bool = False  # the run ended (sim_time_s or steady state): its last checkpoint is not a kill's
 
 
 class PerId:
@@ -1574,6 +1575,7 @@ class BeadRun:
         if m is not None and (not self.series or self.series[-1]["t"] != m["t"]):
             m["steps_per_s"] = steps_block / max(time.perf_counter() - wall_block, 1e-9)
             self.series.append(m)
+        st.finished = True
         self.checkpoint()
         self._write_series()
         out = self._metrics()
