@@ -14,6 +14,8 @@ import time
 import traceback
 from pathlib import Path
 
+import numpy as np
+
 from beadsim.errors import SimulationFailed
 from beadsim.io import write_json
 from beadsim.materials import get_material
@@ -60,8 +62,6 @@ def _can_resume(params: dict, outdir: Path) -> bool:
     previous.pop("run_id", None)
     if previous != json.loads(json.dumps(params)):
         return False
-    import numpy as np
-
     with np.load(state) as data:
         finished = json.loads(str(data["state"])).get("finished", False)
     if finished:

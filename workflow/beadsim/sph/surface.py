@@ -141,7 +141,7 @@ def mass_height_profile(pos, dx, x_window, z_base, z_surface=0.0, mask=None):
     :func:`height_map` reads a surface from the highest particle of each column, which is exact for particles
     stacked in columns (a lattice) but low for a disordered one, whose top particles sit off their columns'
     centres and leave some columns a particle short: in the SPH beads (mode 1, dx 0.4 mm, 39 sections over
-    2-4 s) the map's areas were 0.87 of these and its peak heights 0.91 (both as :func:`smoothed_peak`), while
+    2-4 s) the map's areas were 0.87 of these and its peak heights 0.92 (both as :func:`smoothed_peak`), while
     the frozen melt inside the bead was no denser than the lattice (Voronoi cells of 1.00-1.07 dx^3). This
     profile counts mass instead, so its area is the section's mass by construction; it says nothing about
     where the contact line lies.
