@@ -281,12 +281,25 @@ def test_moving_window_conserves_energy_and_feeds_substrate(tmp_path):
     assert m["bead_samples"] == 3 and m["mass_balance_ratio"] == pytest.approx(sections[-3:].mean(), rel=1e-12)
     assert 0 < m["bead_height_mm"] < 3 * params["wire_diameter_mm"] and m["bead_width_mm"] > 0
     assert 0 < m["bead_height_mass_mm"] < 3 * params["wire_diameter_mm"]
+    # the mean cross-section of the last sections is in the time series: the height map the bead metrics are
+    # measured on (its area is bead_area_mm2) and the mass per column (the peak of the mean is no higher than the
+    # mean of the sections' peaks; its area, with the plate's hollows, is about the metal the wire added: 2.15
+    # against 1.98 mm2 measured, as melted plate moves along the track too and the window's end columns are left out)
+    from beadsim.sph import surface
+
+    dx_mm = params["resolution_mm"]
+    h_map, h_mass = ts.section_height_map_mm.values, ts.section_height_mass_mm.values
+    assert np.nansum(np.clip(h_map, 0, None)) * dx_mm == pytest.approx(m["bead_area_mm2"], rel=1e-9)
+    assert 0.5 * m["bead_height_mass_mm"] < surface.smoothed_peak(h_mass) <= m["bead_height_mass_mm"] + 1e-9
+    assert h_mass.sum() * dx_mm == pytest.approx(m["mass_balance_ratio"] * m["wire_supply_area_mm2"], rel=0.2)
     # resumed at its end (a forced rerun of a finished run resumes from its last checkpoint), the run reports
     # the same bead: the last sections' profiles are in the checkpoint, not only their scalar values
     again = run_case(params, tmp_path, resume=True)
     for key in ("bead_width_mm", "bead_height_mm", "bead_samples", "bead_width_run_mean_mm", "bead_height_mass_mm",
                 "bead_height_mass_run_mean_mm", "mass_balance_ratio", "contact_angle_deg"):
         np.testing.assert_equal(again[key], m[key], err_msg=key)  # NaN (no run mean in so short a run) too
+    resumed = xr.load_dataset(tmp_path / "timeseries.nc")
+    np.testing.assert_array_equal(resumed.section_height_mass_mm.values, h_mass)
     # the workflow resumes a killed run's checkpoint, not a finished run's (a forced rerun runs again)
     from beadsim.runner import _can_resume
 
@@ -357,7 +370,7 @@ def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_s
         if i % 2:
             yi, hi = np.concatenate([[yi[0] - dx], yi]), np.concatenate([[np.nan], h])
         section = {"mass_balance_ratio": ratio, "penetration_depth_mm": 0.1 * i, "fusion_width_mm": 3.0,
-                   **surface.profile_metrics(y, h, dx), "profile": (yi, hi),
+                   **surface.profile_metrics(y, h, dx), "profile": (yi, hi, 1.1 * np.nan_to_num(hi)),
                    "bead_top_phase": 0.45 * (-1) ** i, "bead_top_order": 0.1 * i,
                    "bead_height_mass_mm": 1.1 * caps[i][1] * dx * 1e3}
         monkeypatch.setattr(run, "_bead_metrics", lambda supply, s=section: dict(s))
@@ -393,6 +406,11 @@ def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_s
     assert m["bead_height_mass_run_mean_mm"] == pytest.approx(np.mean(mass_heights[since]), rel=1e-12)
     assert m["bead_height_mass_run_sd_mm"] == pytest.approx(np.std(mass_heights[since], ddof=1), rel=1e-12)
     assert m["mass_balance_run_sd"] == pytest.approx(np.std(ratios[since], ddof=1), rel=1e-12)
+    # the mean section the run keeps for its time series: both profiles averaged on the same aligned bins
+    y_mean, h_map, h_mass = run.section
+    on_y = np.isin(np.rint(y_mean / dx), np.rint(y / dx))
+    np.testing.assert_allclose(h_map[on_y], np.mean(profiles[last], axis=0), rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(h_mass[on_y], 1.1 * np.mean(profiles[last], axis=0), rtol=1e-12, atol=1e-15)
     # stop_at_steady_state waits for bead_sections steady sections: the three that made it steady and later ones
     run.state.steady_time = 0.25  # steady with the sections at 0.15-0.25 s, one more taken since
     assert run._steady_sections_done() == (n_sections <= 4)

@@ -73,3 +73,34 @@ def test_a_measured_mode_on_a_grid_level_does_not_hide_the_other_levels(grid3):
     fig = process_maps(both, "beam_power_W", "substrate_speed_mm_s", "wire_feed_mm_s", ["bead_width_mm"])
     assert len(fig.axes[0].collections) == 1  # still a heat map: the repeated point is averaged into its cell
     plt.close(fig)
+
+
+def test_section_figure_draws_the_run_against_the_measured_cap():
+    """The bead cross-section picture: the measured bead as the circular cap of its width and height (outline
+    through the toes and the apex, area as the comparison's cap), the run's two profiles with their areas, and
+    a note instead of a plot for a run without a section."""
+    from beadsim.reduced import cap_area
+    from beadsim.sph.pictures import cap_outline, section_figure
+
+    yc, zc = cap_outline(3.3, 1.0, n=2001)
+    assert (yc[0], yc[-1]) == (-1.65, 1.65) and zc[[0, -1]] == pytest.approx(0.0, abs=1e-12)
+    assert zc.max() == pytest.approx(1.0, rel=1e-6)
+    assert np.trapezoid(zc, yc) == pytest.approx(cap_area(3.3, 1.0), rel=1e-4)
+    dx = 0.4
+    y = np.arange(-12, 13) * dx
+    h_map = np.clip(0.8 * (1 - (y / 1.6) ** 2), 0, None)
+    ts = xr.Dataset({"section_height_map_mm": ("y_section", h_map),
+                     "section_height_mass_mm": ("y_section", 1.1 * h_map)}, coords={"y_section": y})
+    result = {"run_id": "m1", "status": "ok", "metrics": {"bead_width_mm": 3.2, "bead_height_mm": 0.8,
+                                                          "bead_height_mass_mm": None}}
+    fig = section_figure(ts, dx, result, (3.3, 1.0), 1)
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels[0].endswith(f"{np.sum(h_map) * dx:.2f} mm2 above the plate")
+    assert labels[1].endswith(f"{1.1 * np.sum(h_map) * dx:.2f} mm2") and "3.3 x 1 mm" in labels[2]
+    assert "Table 1 mode 1" in ax.get_title() and "3.20 x 0.80 mm" in ax.get_title()
+    assert ax.get_xlim()[1] >= 1.65 and ax.get_ylim()[1] > 1.0
+    plt.close(fig)
+    failed = section_figure(None, dx, {"run_id": "m2", "status": "failed", "reason": "NaN at t=0.1"})
+    assert "no bead cross-section" in failed.axes[0].texts[0].get_text()
+    plt.close(failed)

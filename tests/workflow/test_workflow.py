@@ -123,4 +123,5 @@ def test_sph_blow_up_is_recorded_and_the_study_completes(tmp_path):
     assert "blown_up" in classes and ("stable" in classes or "degraded" in classes)
     for run in ("dtf1", "dtf8"):
         assert (out / "runs" / run / "bead.png").stat().st_size > 10_000
+        assert (out / "runs" / run / "section.png").stat().st_size > 5_000  # a section, or a note why none
         assert (out / "runs" / run / "deck.in").exists()

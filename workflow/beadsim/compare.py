@@ -63,18 +63,26 @@ def _height_for_area(width: float, area: float) -> float:
     return (lo + hi) / 2
 
 
+def matching_mode(params, exp: pd.DataFrame) -> int | None:
+    """The Table 4 mode whose process parameters (:data:`beadsim.study.EXPERIMENT_PARAMS`) a case's ``params``
+    (a mapping) equal, or None."""
+    for mode, e in exp.iterrows():
+        same = True
+        for k in EXPERIMENT_PARAMS:
+            v = params[k]
+            same &= (str(v) == str(e[k])) if isinstance(e[k], str) else bool(np.isclose(float(v), float(e[k])))
+        if same:
+            return int(mode)
+    return None
+
+
 def match_experiments(ds: xr.Dataset, exp: pd.DataFrame) -> dict[str, int]:
     """Run id -> Table 4 mode, for runs whose process parameters equal a measured mode's."""
     out = {}
     for i, case in enumerate(ds["case"].values):
-        for mode, e in exp.iterrows():
-            same = True
-            for k in EXPERIMENT_PARAMS:
-                v = ds[k].values[i]
-                same &= (str(v) == str(e[k])) if isinstance(e[k], str) else bool(np.isclose(float(v), float(e[k])))
-            if same:
-                out[str(case)] = int(mode)
-                break
+        mode = matching_mode({k: ds[k].values[i] for k in EXPERIMENT_PARAMS}, exp)
+        if mode is not None:
+            out[str(case)] = mode
     return out
 
 

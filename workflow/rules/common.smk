@@ -68,7 +68,7 @@ def get_final_output():
     if "convergence" in analyses:
         extra += [f"{OUT}/convergence/richardson.csv", f"{OUT}/convergence/convergence.png"]
     sph_runs = [r for r in RUN_IDS if DESIGN.loc[r, "model"] == "sph"]
-    extra += expand(f"{OUT}/runs/{{run_id}}/bead.png", run_id=sph_runs)
+    extra += expand(f"{OUT}/runs/{{run_id}}/{{figure}}.png", run_id=sph_runs, figure=("bead", "section"))
     return extra + [
         f"{OUT}/dataset.nc",
         f"{OUT}/summary.csv",

@@ -29,16 +29,24 @@ rule draw_bead:
     input:
         f"{OUT}/runs/{{run_id}}/result.json",
     output:
-        report(
+        temperature=report(
             f"{OUT}/runs/{{run_id}}/bead.png",
             caption="../report/bead.rst",
             category="SPH runs",
             subcategory="{run_id}",
             labels={"run": "{run_id}", "figure": "temperature sections"},
         ),
+        section=report(
+            f"{OUT}/runs/{{run_id}}/section.png",
+            caption="../report/section.rst",
+            category="SPH runs",
+            subcategory="{run_id}",
+            labels={"run": "{run_id}", "figure": "bead cross-section"},
+        ),
     params:
         case=get_case,
         materials=MATERIALS_FILE,
+        experiments=EXPERIMENTS_FILE,
     conda:
         "../../envs/beadsim.yaml"
     log:

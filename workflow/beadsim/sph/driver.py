@@ -722,7 +722,10 @@ class BeadRun:
         self.lammps_time = 0.0
         self.bead_time = 0.0
         self.series_written = -math.inf  # wall clock of the last time-series write
-        self.profiles: list = []  # (y, h) of the last bead_sections bead sections (moving window)
+        # (y, h_map, h_mass) of the last bead_sections bead sections (moving window; checkpoints from before
+        # the mass profile was kept hold (y, h_map))
+        self.profiles: list = []
+        self.section: tuple | None = None  # their mean (y, h_map, h_mass), m, once the run is reduced
         self.particle_steps = 0.0
         self.t_end = params["sim_time_s"]
         self.chunk = int(params["chunk_steps"])
@@ -1671,6 +1674,15 @@ class BeadRun:
         for k in ds.data_vars:
             ds[k].attrs["units"] = "J" if k.startswith("E_") else units.get(k, "1")
         ds["t"] = ds["time"]
+        if self.section is not None and len(self.section[0]):
+            y, h_map, h_mass = (np.asarray(a) * 1e3 for a in self.section)
+            what = (f"mean of the last {len(self.profiles)} bead cross-sections" if self.geom.moving_window
+                    else "bead cross-section at the end") + ", height above the plate"
+            ds = ds.assign_coords(y_section=("y_section", y, {"units": "mm", "long_name": "across the bead"}))
+            ds["section_height_map_mm"] = ("y_section", h_map, {
+                "units": "mm", "long_name": f"{what}: column tops (height map, the bead metrics' profile)"})
+            ds["section_height_mass_mm"] = ("y_section", h_mass, {
+                "units": "mm", "long_name": f"{what}: particles per column at the lattice's density"})
         tmp = self.out / "timeseries.nc.tmp"
         ds.to_netcdf(tmp, engine="scipy")
         os.replace(tmp, self.out / "timeseries.nc")
@@ -1690,7 +1702,7 @@ class BeadRun:
                  face_area=self.per_id.face_area, wire_origin=self.per_id.wire_origin,
                  released=self.per_id.released, landed=self.per_id.landed,
                  series=json.dumps(self.series),
-                 profiles=json.dumps([[np.asarray(y).tolist(), np.asarray(h).tolist()] for y, h in self.profiles]),
+                 profiles=json.dumps([[np.asarray(a).tolist() for a in prof] for prof in self.profiles]),
                  particle_steps=self.particle_steps)
         os.replace(rdir / "state.tmp.npz", rdir / "state.npz")
         self._write_series()
@@ -1712,8 +1724,8 @@ class BeadRun:
         self.series = json.loads(str(data["series"]))
         # the last sections' profiles, so that a run resumed near (or at) its end averages the same sections as
         # the uninterrupted run (checkpoints from before they were kept: the sections taken after the resume)
-        self.profiles = [(np.array(y, dtype=float), np.array(h, dtype=float))
-                         for y, h in json.loads(str(data["profiles"]))] if "profiles" in data else []
+        self.profiles = [tuple(np.array(a, dtype=float) for a in prof)
+                         for prof in json.loads(str(data["profiles"]))] if "profiles" in data else []
         self.particle_steps = float(data["particle_steps"])
         # wall time, throughput and time shares cover the whole run, not only the resumed part
         self.t0_wall = time.perf_counter() - self.state.wall_s
@@ -1812,20 +1824,32 @@ class BeadRun:
                 out["bead_samples"] = len(checks)
                 out.update(run_section_means(sections, p["steady_tolerance"]))
                 out.update(self._pool_means())
-                y, h, n_used = surface.mean_profile(self.profiles, self.num.dx)
+                y, h, n_used = surface.mean_profile([prof[:2] for prof in self.profiles], self.num.dx)
                 if n_used < len(self.profiles):
                     log.warning("bead: %d of %d sections are on another lattice and were left out of the mean",
                                 len(self.profiles) - n_used, len(self.profiles))
+                self.section = (y, h, self._mean_mass_profile(y))
                 with np.errstate(all="ignore"):
                     out.update(surface.profile_metrics(y, h, self.num.dx))
                 if out.get("bead_width_mm"):
                     out["aspect_ratio"] = out["bead_height_mm"] / out["bead_width_mm"]
                 log.info("bead: mean profile of the sections at t = %s s", ", ".join(f"{c['t']:.3f}" for c in checks))
+            if self.section is None and "profile" in out:  # the whole track: the final state's section
+                self.section = out["profile"]
             out.pop("profile", None)
             metal = out.get("mass_balance_ratio", np.nan) * out["wire_supply_area_mm2"]
             if np.isfinite(metal) and metal > 0:
                 out["bead_packing"] = out.get("bead_area_mm2", np.nan) / metal
         return out
+
+    def _mean_mass_profile(self, y: np.ndarray) -> np.ndarray:
+        """Mean of the last sections' mass profiles (:func:`surface.mass_height_profile`) on the bins ``y`` of
+        their mean height map (the same sections, aligned alike); NaN where a section has none (a checkpoint
+        from before they were kept)."""
+        if not all(len(prof) > 2 for prof in self.profiles):
+            return np.full(len(y), np.nan)
+        y_mass, h_mass, _ = surface.mean_profile([(prof[0], prof[2]) for prof in self.profiles], self.num.dx)
+        return h_mass if np.array_equal(y_mass, y) else np.full(len(y), np.nan)
 
     def _pool_means(self, window: float = 0.25) -> dict:
         """Pool length, width, depth and volume: means (and standard deviations, ``*_sd``) of the bead checks
@@ -1905,9 +1929,10 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
     out["mass_balance_ratio"] = net_area / supply_mm2 if supply_mm2 > 0 else np.nan  # no wire: undefined
     y_bins, top = surface.height_map(x[deposit], geom.dx, window, z_surface=0.0)
     out.update(surface.profile_metrics(y_bins, top, geom.dx))
-    mass = surface.mass_height_profile(x, geom.dx, window, geom.z_lo, mask=deposit)[1]
+    # on the height map's bins: the same particles set the same grid of columns
+    mass = surface.mass_height_profile(x[deposit], geom.dx, window, geom.z_lo)[1]
     out["bead_height_mass_mm"] = max(surface.smoothed_peak(mass), 0.0) * 1e3 if len(mass) else np.nan
-    out["profile"] = (y_bins, top)
+    out["profile"] = (y_bins, top, mass)
     out["bead_top_phase"], out["bead_top_order"] = surface.top_layer_registration(x[deposit], geom.dx, window)
     out["penetration_depth_mm"] = surface.penetration_depth(x, melted, geom.dx, window, z_surface=0.0)
     out["fusion_width_mm"] = surface.fusion_width(x[deposit], melted[deposit], geom.dx, window, z_surface=0.0)

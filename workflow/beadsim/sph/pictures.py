@@ -1,4 +1,5 @@
-"""Pictures of an SPH bead run from a particle dump: top view, longitudinal and cross sections by temperature.
+"""Pictures of an SPH bead run: top view, longitudinal and cross sections by temperature from a particle dump, and
+the bead's cross-section against the measured bead (:func:`section_picture`).
 
 As the paper's Figs. 5-8: colour is temperature, the melt pool (T >= T_melt) is outlined in white.
 Particles are binned on a grid of the particle spacing: the top view shows the highest particle of each
@@ -141,9 +142,83 @@ def run_picture(run_dir: str | Path, dx: float, T_melt: float, result: dict) -> 
     status = result.get("status", "?")
     note = f"{result.get('run_id', '')}: {status}" + (f" ({result['reason']})" if result.get("reason") else "")
     if dump is None:
-        fig, ax = plt.subplots(figsize=(6, 1.5))
-        ax.text(0.5, 0.5, f"{note}\nno particle dump was written", ha="center", va="center")
-        ax.axis("off")
-        return fig
+        return _note_figure(f"{note}\nno particle dump was written")
     snap = read_dump(dump)
     return bead_pictures(snap, dx, T_melt, title=f"{note}; step {snap['timestep']}; white: T = {T_melt:g} K")
+
+
+def cap_outline(width: float, height: float, n: int = 101) -> tuple[np.ndarray, np.ndarray]:
+    """(y, z) of the circular cap of base ``width`` and ``height`` centred on y = 0 (any length unit)."""
+    radius = (width ** 2 / 4 + height ** 2) / (2 * height)
+    y = np.linspace(-width / 2, width / 2, n)
+    return y, np.sqrt(np.maximum(radius ** 2 - y ** 2, 0.0)) - (radius - height)
+
+
+def section_picture(y: np.ndarray, h_map: np.ndarray, h_mass: np.ndarray, dx: float,
+                    measured: tuple[float, float] | None = None, title: str = "") -> plt.Figure:
+    """The bead's cross-section as the run measured it, against the measured bead.
+
+    Parameters
+    ----------
+    y, h_map, h_mass : (ny,) arrays, mm
+        Bin centres across the bead and the height above the plate from the column tops (the height map, whose
+        width and height are the bead metrics) and from the particles per column (the mass profile; NaN if the
+        run has none), e.g. the ``section_*`` variables of a run's ``timeseries.nc``.
+    dx : float, mm
+        Particle spacing (the bins' width).
+    measured : (width, height), mm, optional
+        The measured bead (Table 1), drawn as a circular cap on the bead's axis.
+    """
+    fig, ax = plt.subplots(figsize=(8, 3.2))
+    ax.axhline(0.0, color="0.6", lw=0.8)
+    area = np.nansum(np.clip(h_map, 0, None)) * dx
+    ax.step(y, h_map, where="mid", color="C0", label=f"column tops (height map), {area:.2f} mm2 above the plate")
+    if np.isfinite(h_mass).any():
+        area = np.nansum(np.clip(h_mass, 0, None)) * dx
+        ax.plot(y, h_mass, "o-", ms=3, color="C1", label=f"particles per column (mass), {area:.2f} mm2")
+    if measured is not None:
+        w, h = measured
+        yc, zc = cap_outline(w, h)
+        ax.plot(yc, zc, "k--", label=f"measured bead as a circular cap, {w:g} x {h:g} mm")
+    ax.set_xlabel("y across the bead [mm]")
+    ax.set_ylabel("height above the plate [mm]")
+    top = np.nanmax(np.concatenate([np.atleast_1d(h_map), np.atleast_1d(h_mass), [measured[1] if measured else 0]]))
+    ax.set_ylim(-0.25, 1.25 * top + dx)
+    with np.errstate(invalid="ignore"):
+        raised = np.abs(y[(h_map > dx / 4) | (h_mass > dx / 4)])
+    half = max(raised.max() if len(raised) else 0.0, measured[0] / 2 if measured else 0.0)
+    if half > 0:
+        ax.set_xlim(-half - 2 * dx, half + 2 * dx)
+    ax.legend(fontsize=8, loc="upper right")
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def _note_figure(text: str) -> plt.Figure:
+    fig, ax = plt.subplots(figsize=(6, 1.5))
+    ax.text(0.5, 0.5, text, ha="center", va="center")
+    ax.axis("off")
+    return fig
+
+
+def section_figure(series, dx: float, result: dict, measured: tuple[float, float] | None = None,
+                   mode: int | None = None) -> plt.Figure:
+    """:func:`section_picture` of a run from its time series (an xarray Dataset of ``timeseries.nc`` with the
+    ``section_*`` variables, or None), titled with its status, bead metrics and measured mode; a note figure if
+    the run has no section (it failed, or no bead had formed behind the pool)."""
+    note = f"{result.get('run_id', '')}: {result.get('status', '?')}" + (
+        f" ({result['reason']})" if result.get("reason") else "")
+    if series is None or "section_height_map_mm" not in series:
+        return _note_figure(f"{note}\nno bead cross-section was recorded")
+    m = result.get("metrics") or {}
+
+    def mm(key):
+        v = m.get(key)
+        return "-" if v is None else f"{v:.2f}"
+
+    title = (f"{note}; bead {mm('bead_width_mm')} x {mm('bead_height_mm')} mm (height map), "
+             f"{mm('bead_height_mass_mm')} mm high by mass"
+             + (f"; Table 1 mode {mode}: {measured[0]:g} x {measured[1]:g} mm" if measured else ""))
+    return section_picture(series["y_section"].values, series["section_height_map_mm"].values,
+                           series["section_height_mass_mm"].values, dx, measured, title)
