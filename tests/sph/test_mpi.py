@@ -6,6 +6,8 @@ quantities must agree exactly and the rest within a few percent (measured: evapo
 """
 
 import re
+import time
+from pathlib import Path
 
 import pytest
 import xarray as xr
@@ -16,12 +18,15 @@ from beadsim.sph.mpi_main import run_mpi
 
 from test_bead import HEIGHT_FUNCTION, small_case
 
+# s: a 2-rank job that hangs fails its test instead of holding the suite (each takes under a minute here)
+TIMEOUT = 900
+
 
 @pytest.mark.mpi
 def test_one_and_two_ranks_agree(tmp_path):
     params = small_case(sim_time_s=0.25)
     one = run_case(params, tmp_path / "one")
-    two = run_mpi(params, tmp_path / "two", tasks=2)
+    two = run_mpi(params, tmp_path / "two", tasks=2, timeout=TIMEOUT)
     assert two["mpi_ranks"] == 2
     assert two["n_particles"] == one["n_particles"]
     assert two["n_steps"] == one["n_steps"]
@@ -46,8 +51,24 @@ def test_failure_on_ranks_comes_back_as_simulation_failed(tmp_path):
     # dt 8x the limit trips the watchdog within ~40 steps: as lost particles or a density excursion, whichever
     # shows first (the reason is the driver's own, passed back from the ranks)
     with pytest.raises(SimulationFailed, match=r"(density|particles lost).* at t="):
-        run_mpi(small_case(sim_time_s=0.05, dt_factor=8.0), tmp_path, tasks=2)
+        run_mpi(small_case(sim_time_s=0.05, dt_factor=8.0), tmp_path, tasks=2, timeout=TIMEOUT)
     assert (tmp_path / "dumps" / "failed.lammpstrj").exists()
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("kind", ["lammps", "python"])
+def test_a_rank_that_fails_alone_ends_the_job(tmp_path, kind):
+    """An error on one rank only (LAMMPS's error->one, or a Python error in the driver there) leaves the other
+    rank waiting inside LAMMPS's run: before the failing rank aborted the job, such a run hung until killed (a CI
+    run sat 75 min in the smoothed-ceiling test below). Now the failing rank writes the reason and aborts: the
+    run fails in seconds with that reason, and the timeout (which would say so) never fires."""
+    start = time.perf_counter()
+    with pytest.raises(SimulationFailed, match=r"on rank 1 of 2 at t=0\.00[0-9]+ s") as err:
+        run_mpi(small_case(sim_time_s=0.05), tmp_path, tasks=2, timeout=300,
+                entry=(str(Path(__file__).with_name("mpi_fault.py")), kind, "1", "3"))
+    assert "injected" in err.value.reason and "timeout" not in err.value.reason
+    assert err.value.metrics["n_steps"] > 0 and err.value.metrics["dx_mm"] == pytest.approx(0.4)
+    assert time.perf_counter() - start < 120
 
 
 @pytest.mark.mpi
@@ -56,7 +77,7 @@ def test_moving_window_on_two_ranks(tmp_path):
     count as one rank, ledger closed."""
     params = small_case(domain="window", window_thermal_lengths=4.0, sim_time_s=0.12)
     one = run_case(params, tmp_path / "one")
-    two = run_mpi(params, tmp_path / "two", tasks=2)
+    two = run_mpi(params, tmp_path / "two", tasks=2, timeout=TIMEOUT)
     assert two["n_particles"] == one["n_particles"] and two["n_steps"] == one["n_steps"]
     assert abs(two["energy_balance_error"]) < 1e-3
     ts = xr.load_dataset(tmp_path / "two" / "timeseries.nc")
@@ -77,7 +98,7 @@ def test_smoothed_loose_melt_ceiling_on_two_ranks(tmp_path):
                         density_tolerance=0.5, loose_melt_ceiling=True, loose_melt_d3=0.985,
                         loose_melt_smoothing=1.5)
     one = run_case(params, tmp_path / "one")
-    two = run_mpi(params, tmp_path / "two", tasks=2)
+    two = run_mpi(params, tmp_path / "two", tasks=2, timeout=TIMEOUT)
     assert "comm_modify vel yes cutoff" in (tmp_path / "two" / "deck.in").read_text()
     assert two["n_particles"] == one["n_particles"] and two["n_steps"] == one["n_steps"]
     assert abs(two["energy_balance_error"]) < 1e-3 and abs(one["energy_balance_error"]) < 1e-3
@@ -97,7 +118,7 @@ def test_height_function_on_two_ranks(tmp_path):
     force written to the wrong particle would show."""
     params = small_case(**HEIGHT_FUNCTION, sim_time_s=0.03)
     one = run_case(params, tmp_path / "one")
-    two = run_mpi(params, tmp_path / "two", tasks=2)
+    two = run_mpi(params, tmp_path / "two", tasks=2, timeout=TIMEOUT)
     assert two["n_particles"] + two["spatter_particles"] == one["n_particles"] + one["spatter_particles"]
     assert two["n_steps"] == one["n_steps"]
     assert abs(two["energy_balance_error"]) < 1e-3 and abs(one["energy_balance_error"]) < 1e-3

@@ -20,3 +20,12 @@ class SimulationFailed(RuntimeError):
         super().__init__(reason)
         self.reason = reason
         self.metrics = dict(metrics or {})
+
+
+class RankFailure(SimulationFailed):
+    """A failure on one MPI rank alone (a LAMMPS error raised on one rank, a Python error in the driver there).
+
+    The other ranks may be waiting for this one inside LAMMPS or in a collective, so the run cannot wind down
+    together: the rank writes what it knows and aborts the job (:mod:`beadsim.sph.mpi_main`). Its metrics are
+    this rank's own, gathered without communication.
+    """

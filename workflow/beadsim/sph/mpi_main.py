@@ -2,7 +2,9 @@
 
 Every rank runs the same driver (LAMMPS splits the particles; the driver reduces whatever it computes between
 chunks over ranks). Rank 0 writes ``mpi_result.json`` (status, reason, metrics), which :func:`run_mpi`, called by
-the runner in the parent process, turns back into metrics or a :class:`SimulationFailed`.
+the runner in the parent process, turns back into metrics or a :class:`SimulationFailed`. A rank that fails alone
+(:class:`~beadsim.errors.RankFailure`: a LAMMPS error on that rank, a Python error in the driver there) writes the
+result itself and aborts the job, since the others wait for it and would wait forever.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import sys
 import threading
 from pathlib import Path
 
-from beadsim.errors import SimulationFailed
+from beadsim.errors import RankFailure, SimulationFailed
 from beadsim.io import write_json
 
 RESULT = "mpi_result.json"
@@ -24,9 +26,16 @@ RESULT = "mpi_result.json"
 log = logging.getLogger("beadsim.sph.mpi")
 
 
+ENTRY = ("-m", "beadsim.sph.mpi_main")
+
+
 def run_mpi(params: dict, outdir: Path, tasks: int, mpi: str = "mpirun", materials_file=None,
-            resume: bool = False, timeout: float | None = None) -> dict:
+            resume: bool = False, timeout: float | None = None, entry: tuple[str, ...] = ENTRY) -> dict:
     """Launch the case on ``tasks`` ranks with ``mpi`` (e.g. "mpirun", "srun --mpi=pmi2"); return its metrics.
+
+    ``timeout`` (s) ends the ranks (SIGTERM to the launcher, which passes it on) and fails the run. ``entry`` is
+    what each rank runs after ``python``, with the output folder appended (tests start a wrapper around
+    :func:`main` that breaks one rank).
 
     Raises
     ------
@@ -44,13 +53,19 @@ def run_mpi(params: dict, outdir: Path, tasks: int, mpi: str = "mpirun", materia
         from beadsim.lammps_env import mpirun
 
         launcher[0] = mpirun()
-    cmd = [*launcher, "-n", str(tasks), sys.executable, "-m", "beadsim.sph.mpi_main", str(outdir)]
+    cmd = [*launcher, "-n", str(tasks), sys.executable, *entry, str(outdir)]
     # The ranks' output (rank 0's progress lines) goes to mpi.log and to this process's log as it comes, so a
     # multi-rank run shows its progress while it runs.
     tail: collections.deque = collections.deque(maxlen=3)
     with open(outdir / "mpi.log", "w", buffering=1) as fh:
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1)
-        timer = threading.Timer(timeout, proc.kill) if timeout else None
+        timed_out = threading.Event()
+
+        def expire():
+            timed_out.set()
+            _kill(proc)
+
+        timer = threading.Timer(timeout, expire) if timeout else None
         if timer:
             timer.start()
         try:
@@ -60,11 +75,15 @@ def run_mpi(params: dict, outdir: Path, tasks: int, mpi: str = "mpirun", materia
                     tail.append(line.strip())
                     log.info("ranks: %s", line.rstrip())
             code = proc.wait()
+        except BaseException:  # interrupted here (Ctrl-C, a test's timeout): the ranks go too
+            _kill(proc)
+            proc.wait()
+            raise
         finally:
             if timer:
                 timer.cancel()
     if not (outdir / RESULT).exists():
-        why = f"was killed after the timeout of {timeout} s" if timer and code < 0 else f"exited with code {code}"
+        why = f"was killed after the timeout of {timeout} s" if timed_out.is_set() else f"exited with code {code}"
         raise SimulationFailed(f"MPI run ({' '.join(cmd[:3])} ...) {why} and no result: {' | '.join(tail)}")
     result = json.loads((outdir / RESULT).read_text())
     metrics = {k: (float("nan") if v is None else v) for k, v in result["metrics"].items()}
@@ -72,6 +91,15 @@ def run_mpi(params: dict, outdir: Path, tasks: int, mpi: str = "mpirun", materia
     if result["status"] != "ok":
         raise SimulationFailed(result["reason"], metrics)
     return metrics
+
+
+def _kill(proc: subprocess.Popen, grace: float = 10.0) -> None:
+    """End the launcher with SIGTERM, which it passes on to the ranks (mpiexec, srun); SIGKILL after ``grace`` s."""
+    proc.terminate()
+    try:
+        proc.wait(grace)
+    except subprocess.TimeoutExpired:
+        proc.kill()
 
 
 def main(outdir: str) -> None:
@@ -94,6 +122,14 @@ def main(outdir: str) -> None:
     status, reason, metrics = "ok", "", {}
     try:
         metrics = run_case(params, out, material=material, resume=spec["resume"])
+    except RankFailure as exc:
+        # this rank alone failed; the others wait for it (inside LAMMPS or in a collective) and would wait
+        # forever: write the reason from here (rank 0 may be one of the waiting) and abort the job
+        log.error("rank %d: %s", comm.rank, exc.reason, exc_info=exc.__cause__)
+        write_json(out / RESULT, {"status": "failed", "reason": exc.reason, "metrics": exc.metrics,
+                                  "ranks": comm.size})
+        sys.stderr.flush()
+        comm.Abort(1)
     except SimulationFailed as exc:
         status, reason, metrics = "failed", exc.reason, exc.metrics
     if comm.rank == 0:
