@@ -4,6 +4,7 @@ runs :func:`beadsim.sph.mpi_main.main` with a fault on rank RANK at its CHUNK-th
 KIND ``lammps``: that rank's ``run`` command raises the exception LAMMPS raises for an error on one rank
 (error->one, ``MPIAbortException``) without entering the run, so the other ranks wait for it inside LAMMPS.
 KIND ``python``: a Python error in the driver on that rank just before the chunk, so the others go on into the run.
+KIND ``close``: an error on that rank when the finished run writes its time series and closes LAMMPS (CHUNK unused).
 """
 
 import sys
@@ -35,7 +36,12 @@ def main(kind: str, rank: int, chunk: int, outdir: str) -> None:
                 raise ZeroDivisionError("injected Python error on one rank")
             volumetric_heat(self, dt_chunk)
 
+        def close(self):
+            raise OSError("injected error writing the time series on one rank")
+
         driver.Deck.__call__, driver.BeadRun._volumetric_heat = deck, heat
+        if kind == "close":
+            driver.BeadRun.close = close
     mpi_main.main(outdir)
 
 

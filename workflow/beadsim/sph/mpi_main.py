@@ -122,18 +122,24 @@ def main(outdir: str) -> None:
     status, reason, metrics = "ok", "", {}
     try:
         metrics = run_case(params, out, material=material, resume=spec["resume"])
-    except RankFailure as exc:
-        # this rank alone failed; the others wait for it (inside LAMMPS or in a collective) and would wait
-        # forever: write the reason from here (rank 0 may be one of the waiting) and abort the job
-        log.error("rank %d: %s", comm.rank, exc.reason, exc_info=exc.__cause__)
-        write_json(out / RESULT, {"status": "failed", "reason": exc.reason, "metrics": exc.metrics,
-                                  "ranks": comm.size})
-        sys.stderr.flush()
-        comm.Abort(1)
     except SimulationFailed as exc:
+        if isinstance(exc, RankFailure):
+            _abort(comm, out, exc.reason, exc.metrics, exc.__cause__)
         status, reason, metrics = "failed", exc.reason, exc.metrics
+    except BaseException as exc:  # any other error, perhaps on this rank alone (in rank 0's file writing, say)
+        _abort(comm, out, f"{type(exc).__name__} on rank {comm.rank} of {comm.size}: {exc}", {}, exc)
     if comm.rank == 0:
         write_json(out / RESULT, {"status": status, "reason": reason, "metrics": metrics, "ranks": comm.size})
+
+
+def _abort(comm, out: Path, reason: str, metrics: dict, cause: BaseException | None) -> None:
+    """A failure on this rank that the others may never learn of (they wait for it inside LAMMPS or in a
+    collective, and would wait forever): write the result from here (rank 0 may be one of the waiting), then
+    end the whole job."""
+    log.error("rank %d: %s", comm.rank, reason, exc_info=cause)
+    write_json(out / RESULT, {"status": "failed", "reason": reason, "metrics": metrics, "ranks": comm.size})
+    sys.stderr.flush()
+    comm.Abort(1)
 
 
 if __name__ == "__main__":
