@@ -12,6 +12,7 @@ from __future__ import annotations
 import collections
 import json
 import logging
+import os
 import shlex
 import subprocess
 import sys
@@ -90,6 +91,9 @@ def run_mpi(params: dict, outdir: Path, tasks: int, mpi: str = "mpirun", materia
     metrics["mpi_ranks"] = result["ranks"]
     if result["status"] != "ok":
         raise SimulationFailed(result["reason"], metrics)
+    if code != 0:
+        raise SimulationFailed(f"MPI run ({' '.join(cmd[:3])} ...) exited with code {code} after writing a result: "
+                               f"{' | '.join(tail)}", metrics)
     return metrics
 
 
@@ -140,6 +144,9 @@ def _abort(comm, out: Path, reason: str, metrics: dict, cause: BaseException | N
     write_json(out / RESULT, {"status": "failed", "reason": reason, "metrics": metrics, "ranks": comm.size})
     sys.stderr.flush()
     comm.Abort(1)
+    # MPI_Abort can return before the launcher ends this process (seen: rank 0 went on and wrote "ok" over the
+    # failure); nothing may run after it
+    os._exit(1)
 
 
 if __name__ == "__main__":
