@@ -1797,26 +1797,27 @@ class BeadRun:
                 "wire_feed_end_share": float(at_end.mean())}
 
     def _local_metrics(self) -> dict:
-        """What this rank knows without communicating: spacing, step, process time reached, wall time."""
+        """What this rank knows without communicating: spacing, step, process time reached, wall time (the
+        start of :meth:`_metrics`, and all a :class:`RankFailure` reports)."""
         wall = time.perf_counter() - self.t0_wall
         return {"dx_mm": self.num.dx * 1e3, "dt_s": self.num.dt, "n_steps": self.state.step,
                 "simulated_time_s": self.state.t, "wall_time_s": wall}
 
     def _metrics(self, partial: bool = False) -> dict:
         p, st, num = self.p, self.state, self.num
-        wall = time.perf_counter() - self.t0_wall
+        out = self._local_metrics()
+        wall = out["wall_time_s"]
         last = self.series[-1] if self.series else {}
-        out = {"n_particles": int(self.lmp.get_natoms()), "dx_mm": num.dx * 1e3, "dt_s": num.dt,
-               "sound_speed_used_m_s": num.c0, "n_steps": st.step, "simulated_time_s": st.t,
-               "steady_state_time_s": st.steady_time, "wall_time_s": wall,
-               "particle_steps_per_s": self.particle_steps / wall if wall > 0 else np.nan,
-               "python_time_share": 1 - self.lammps_time / wall if wall > 0 else np.nan,
-               "T_max_K": st.t_max, "melt_speed_max_m_s": st.v_max, "density_min": st.rho_min,
-               "density_max": st.rho_max, "energy_in_J": st.ledger.beam,
-               "energy_balance_error": last.get("energy_error", np.nan),
-               "evaporated_energy_J": st.ledger.evaporated, "boundary_heat_loss_J": st.ledger.boundary,
-               "spatter_particles": st.n_ejected, "surface_work_J": st.ledger.surface_work,
-               "absorbed_power_W": p["beam_power_W"] * p["beam_efficiency"]}
+        out.update({"n_particles": int(self.lmp.get_natoms()), "sound_speed_used_m_s": num.c0,
+                    "steady_state_time_s": st.steady_time,
+                    "particle_steps_per_s": self.particle_steps / wall if wall > 0 else np.nan,
+                    "python_time_share": 1 - self.lammps_time / wall if wall > 0 else np.nan,
+                    "T_max_K": st.t_max, "melt_speed_max_m_s": st.v_max, "density_min": st.rho_min,
+                    "density_max": st.rho_max, "energy_in_J": st.ledger.beam,
+                    "energy_balance_error": last.get("energy_error", np.nan),
+                    "evaporated_energy_J": st.ledger.evaporated, "boundary_heat_loss_J": st.ledger.boundary,
+                    "spatter_particles": st.n_ejected, "surface_work_J": st.ledger.surface_work,
+                    "absorbed_power_W": p["beam_power_W"] * p["beam_efficiency"]})
         area_w = math.pi * (p["wire_diameter_mm"] / 2) ** 2
         out["wire_supply_area_mm2"] = self._supply_mm2()
         out["wire_released_particles"] = int(self.per_id.released.sum())
