@@ -524,3 +524,30 @@ def test_annealed_ridge_forgets_where_it_started():
     wide, tall = _ridge(12, 2, anneal=0.3, t_end=0.2), _ridge(4, 6, anneal=0.3, t_end=0.2)
     assert abs(wide["angle_deg"] - tall["angle_deg"]) < 8
     assert 45 < (wide["angle_deg"] + tall["angle_deg"]) / 2 < 62
+
+
+def test_table_file_is_whole_while_another_rank_rewrites_it(tmp_path):
+    """Under MPI every rank writes the table while rank 0 may be reading it: a reader never sees part of it.
+    (A plain write let rank 0 parse a half-written table in CI, "Error parsing pair table 'LL' line 1456 of
+    2000", and the 2-rank run stopped there.)"""
+    import subprocess
+    import sys
+
+    model = CohesionModel.from_material(TI, DX, wetting_ratio=0.8)
+    table = model.write_table(tmp_path / "tension.table")
+    whole = table.read_text()
+    writer = subprocess.Popen([sys.executable, "-c", (
+        "import sys; from beadsim.materials import get_material; from beadsim.sph.tension import CohesionModel\n"
+        f"m = CohesionModel.from_material(get_material('Ti-Gr2'), {DX!r}, wetting_ratio=0.8)\n"
+        "print('ready', flush=True)\n"
+        f"for _ in range(400): m.write_table({str(table)!r})\n")], stdout=subprocess.PIPE, text=True)
+    try:
+        assert writer.stdout.readline().strip() == "ready"
+        reads = []
+        while writer.poll() is None:
+            reads.append(table.read_text())
+    finally:
+        writer.wait(timeout=120)
+    assert writer.returncode == 0
+    assert len(reads) > 20
+    assert sum(r != whole for r in reads) == 0

@@ -41,6 +41,7 @@ import numpy as np
 import xarray as xr
 from scipy.spatial import cKDTree
 
+from beadsim import io
 from beadsim.compare import wire_supply_area
 from beadsim.errors import RankFailure, SimulationFailed
 from beadsim.lammps_env import new_lammps
@@ -2021,7 +2022,6 @@ def run_case(params: dict, outdir: Path, progress=None, resume: bool = False,
 
 
 def write_metrics(path: Path, metrics: dict) -> None:
-    """Write the metrics as JSON (NaN as null)."""
-    with open(path, "w") as fh:
-        json.dump({k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in metrics.items()},
-                  fh, indent=1)
+    """Write the metrics as JSON (NaN and infinities as null), atomically."""
+    io.write_text(path, json.dumps(
+        {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in metrics.items()}, indent=1))

@@ -122,6 +122,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import brentq
 
+from beadsim import io
 from beadsim.materials import Material
 
 #: Kernel support h as a multiple of the particle spacing dx used by the bead driver (cutoff 2.5 dx).
@@ -391,6 +392,10 @@ class CohesionModel:
 
         The table starts at r = 0.02 h: LAMMPS stops with an error if two particles come closer, which
         the SPH pressure prevents (closest pairs stay above ~0.5 dx).
+
+        The file is replaced atomically: under MPI every rank writes it while rank 0 may already be reading
+        it (a plain write let rank 0 read a half-written table: "Error parsing pair table 'LL' line 1456 of
+        2000", which hung a 2-rank CI run until the abort on one rank's error existed).
         """
         path = Path(path)
         r = np.linspace(0.02 * self.h, self.h, self.table_points)
@@ -399,7 +404,7 @@ class CohesionModel:
             lines += ["", key, f"N {self.table_points} R {r[0]:.12g} {r[-1]:.12g}", ""]
             e, f = self.energy(r, s), self.force(r, s)
             lines += [f"{i + 1} {ri:.12g} {ei:.12g} {fi:.12g}" for i, (ri, ei, fi) in enumerate(zip(r, e, f))]
-        path.write_text("\n".join(lines) + "\n")
+        io.write_text(path, "\n".join(lines) + "\n")
         return path
 
     def pair_coeff_commands(
