@@ -45,7 +45,9 @@ def test_error_table_gives_the_run_means_beside_the_last_sections(experiments):
                 bead_height_run_mean_mm=("case", [0.8, np.nan]), bead_width_run_sd_mm=("case", [0.6, np.nan]),
                 bead_height_run_sd_mm=("case", [0.2, np.nan]), bead_height_mass_mm=("case", [0.98, np.nan]),
                 bead_height_mass_run_mean_mm=("case", [0.93, np.nan]),
-                bead_height_mass_run_sd_mm=("case", [0.4, np.nan]))
+                bead_height_mass_run_sd_mm=("case", [0.4, np.nan]), bead_width_mass_mm=("case", [3.9, np.nan]),
+                bead_width_mass_run_mean_mm=("case", [3.8, np.nan]),
+                bead_width_mass_run_sd_mm=("case", [0.7, np.nan]))
     ds = xr.Dataset(data, coords={"case": cases})
     t = error_table(ds, experiments).set_index("run_id")
     w, h = mode1["bead_width_mm"], mode1["bead_height_mm"]
@@ -74,17 +76,22 @@ def test_error_table_gives_the_run_means_beside_the_last_sections(experiments):
     assert t.loc["sph_run", "height_mass_run_mean_err_rel"] == pytest.approx((0.93 - h) / h)
     assert t.loc["sph_run", "height_mass_err_rel"] == pytest.approx((0.98 - h) / h)
     assert t.loc["reduced_run", ["height_mass_pred_mm", "height_mass_run_mean_mm"]].isna().all()
-    width_labels, height_labels = (ax.get_legend_handles_labels()[1] for ax in fig.axes)
-    assert sum("mass per column" in lab for lab in height_labels) == 1
-    assert not any("mass per column" in lab for lab in width_labels)
-    assert fig.axes[1].get_ylim()[1] >= 0.93 + 0.4
+    # and the width from it
+    assert t.loc["sph_run", "width_mass_err_rel"] == pytest.approx((3.9 - w) / w)
+    assert t.loc["sph_run", "width_mass_run_mean_err_rel"] == pytest.approx((3.8 - w) / w)
+    assert t.loc["sph_run", "width_mass_run_sd_mm"] == pytest.approx(0.7)
+    assert t.loc["reduced_run", ["width_mass_pred_mm", "width_mass_run_mean_mm"]].isna().all()
+    for ax, q, top in zip(fig.axes, ("width", "height"), (3.8 + 0.7, 0.93 + 0.4)):
+        assert sum(f"{q} from the mass per column" in lab for lab in ax.get_legend_handles_labels()[1]) == 1
+        assert ax.get_ylim()[1] >= top
     for ax in fig.axes:  # one band per SPH spacing
         assert sum("read by the measure" in lab for lab in ax.get_legend_handles_labels()[1]) == 1
     # a dataset of reduced runs only has no run-mean variables at all
     t = error_table(ds.drop_vars(["bead_width_run_mean_mm", "bead_height_run_mean_mm", "bead_width_run_sd_mm",
                                   "bead_height_run_sd_mm", "bead_height_mass_mm", "bead_height_mass_run_mean_mm",
-                                  "bead_height_mass_run_sd_mm"]), experiments)
+                                  "bead_height_mass_run_sd_mm", "bead_width_mass_mm", "bead_width_mass_run_mean_mm",
+                                  "bead_width_mass_run_sd_mm"]), experiments)
     assert t["width_run_mean_mm"].isna().all() and t["height_run_sd_mm"].isna().all() and len(t) == 2
     fig = parity_plot(t, measured_mass_balance(experiments))
     assert not any("run mean" in lab for ax in fig.axes for lab in ax.get_legend_handles_labels()[1])
-    assert t["height_mass_run_mean_mm"].isna().all()
+    assert t["height_mass_run_mean_mm"].isna().all() and t["width_mass_run_mean_mm"].isna().all()

@@ -22,6 +22,7 @@ from beadsim.sph.surface import (
     lattice_cap_readings,
     lattice_phase,
     mass_height_profile,
+    mass_width,
     penetration_depth,
     pool_geometry,
     smoothed_peak,
@@ -313,6 +314,29 @@ def test_mass_height_profile_of_a_lattice_cap_is_its_height_map():
     np.testing.assert_allclose(mass, top, atol=1e-12)
     n_cap = int((pos[:, 2] > 0).sum())
     assert np.sum(mass) * DX == pytest.approx(n_cap * DX**3 / (WINDOW[1] - WINDOW[0]), rel=1e-9)
+
+
+def test_mass_width_counts_toe_metal_the_height_map_misses():
+    """A lattice cap: the width by mass is the height map's width. Add, on each side, three bins where every
+    other x column holds two particles (7 of the 18 columns the mean takes: 0.78 dx of metal per column): the
+    map's median column is bare there, so its width stays; the mass crosses dx/2 three bins further out on
+    each side, the edges interpolated as before (a fraction (h - dx/2) / h of a bin beyond the edge bin)."""
+    pos = bead_cloud(60.0)
+    width = bead_cross_section(pos, DX, WINDOW)["bead_width_mm"] * 1e-3
+    y, mass = mass_height_profile(pos, DX, WINDOW, -1e-3)
+    assert mass_width(y, mass, DX) == pytest.approx(width, abs=1e-12)
+    run = np.flatnonzero(mass > 0.5 * DX)
+    columns = range(0, 16, 2)  # x columns holding toe metal; the window's first and last are left out of means
+    toes = [((ix + 0.5) * DX, edge + side * k * DX, (iz + 0.5) * DX)
+            for side, edge in ((-1, y[run[0]]), (1, y[run[-1]])) for k in (1, 2, 3) for ix in columns for iz in (0, 1)]
+    wide = np.vstack([pos, toes])
+    assert bead_cross_section(wide, DX, WINDOW)["bead_width_mm"] * 1e-3 == pytest.approx(width, abs=1e-12)
+    y_w, mass_w = mass_height_profile(wide, DX, WINDOW, -1e-3)
+    toe = 2 * DX * 7 / 18
+    assert mass_w.max() == mass.max()
+    edge = mass[run[0]]
+    assert mass_width(y_w, mass_w, DX) == pytest.approx(
+        width + 2 * (3 + (toe - 0.5 * DX) / toe - (edge - 0.5 * DX) / edge) * DX, rel=1e-9)
 
 
 def test_mass_height_profile_reads_a_disordered_surface_the_height_map_reads_low():

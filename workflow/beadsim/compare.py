@@ -113,23 +113,26 @@ def error_table(ds: xr.Dataset, exp: pd.DataFrame) -> pd.DataFrame:
                 row[f"{q}_run_{stat}_mm"] = float(ds[run].values[i]) if run in ds else np.nan
             row[f"{q}_run_mean_err_rel"] = (row[f"{q}_run_mean_mm"] - meas) / meas
         row.update(lattice_reading(exp.loc[mode], row["model"], row["resolution_mm"]))
-        # SPH: the height from the mass per column (surface.mass_height_profile), which a disordered frozen melt
-        # does not read low; for a bead of Table 1's shape it is Table 1's height, so no lattice reading here
-        for src, dst in (("bead_height_mass_mm", "pred_mm"), ("bead_height_mass_run_mean_mm", "run_mean_mm"),
-                         ("bead_height_mass_run_sd_mm", "run_sd_mm")):
-            row[f"height_mass_{dst}"] = float(ds[src].values[i]) if src in ds else np.nan
-        meas = row["height_meas_mm"]
-        row["height_mass_err_rel"] = (row["height_mass_pred_mm"] - meas) / meas
-        row["height_mass_run_mean_err_rel"] = (row["height_mass_run_mean_mm"] - meas) / meas
+        # SPH: height and width from the mass per column (surface.mass_height_profile), which a disordered frozen
+        # melt does not read low and thin metal at the toes does not escape; for a bead of Table 1's shape the
+        # height is Table 1's height (so no lattice reading for it), the width reads as the width_lattice_* do
+        for q in ("width", "height"):
+            for src, dst in (("mm", "pred_mm"), ("run_mean_mm", "run_mean_mm"), ("run_sd_mm", "run_sd_mm")):
+                src = f"bead_{q}_mass_{src}"
+                row[f"{q}_mass_{dst}"] = float(ds[src].values[i]) if src in ds else np.nan
+            meas = row[f"{q}_meas_mm"]
+            row[f"{q}_mass_err_rel"] = (row[f"{q}_mass_pred_mm"] - meas) / meas
+            row[f"{q}_mass_run_mean_err_rel"] = (row[f"{q}_mass_run_mean_mm"] - meas) / meas
         rows.append(row)
     cols = ["run_id", "mode", "model", "resolution_mm", "status", "measured_mass_consistent"] + [
         f"{q}_{s}" for q in ("width", "height")
         for s in ("pred_mm", "meas_mm", "unc_mm", "err_mm", "err_rel", "run_mean_mm", "run_sd_mm",
-                  "run_mean_err_rel") + LATTICE_READINGS] + [f"height_mass_{s}" for s in MASS_COLUMNS]
+                  "run_mean_err_rel") + LATTICE_READINGS] + [
+        f"{q}_mass_{s}" for q in ("width", "height") for s in MASS_COLUMNS]
     return pd.DataFrame(rows, columns=cols)
 
 
-#: Columns of the height from the mass per column (after ``height_mass_``)
+#: Columns of the width and height from the mass per column (after ``width_mass_`` / ``height_mass_``)
 MASS_COLUMNS = ("pred_mm", "err_rel", "run_mean_mm", "run_sd_mm", "run_mean_err_rel")
 
 

@@ -29,6 +29,13 @@ METRICS: dict[str, tuple[str, str]] = {
                                      "the wire's metal arrived (SPH window)"),
     "bead_height_mass_run_sd_mm": ("mm", "bead height from the mass per column, standard deviation of the "
                                    "cross-sections since the wire's metal arrived (SPH window)"),
+    "bead_width_mass_mm": ("mm", "bead width from the mass per column: where the particles counted per column "
+                           "at the lattice's density reach half a spacing, edges interpolated (SPH; mean of the "
+                           "averaged cross-sections in a window run)"),
+    "bead_width_mass_run_mean_mm": ("mm", "bead width from the mass per column, mean of the cross-sections since "
+                                    "the wire's metal arrived (SPH window)"),
+    "bead_width_mass_run_sd_mm": ("mm", "bead width from the mass per column, standard deviation of the "
+                                  "cross-sections since the wire's metal arrived (SPH window)"),
     "mass_balance_run_mean": ("1", "mass balance ratio, mean of the cross-sections since the wire's metal "
                               "arrived (SPH window)"),
     "mass_balance_run_sd": ("1", "mass balance ratio, standard deviation of the cross-sections since the wire's "

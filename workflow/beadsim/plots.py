@@ -250,9 +250,9 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
     """Predicted vs measured bead width and height, one marker per run; hollow where the measured bead fails
     its own mass balance (the wire fed more metal than the bead holds). SPH window runs with run means (the
     mean of every section since the wire's metal arrived) get a second marker, x, with the sections' standard
-    deviation as error bar, beside the last sections' bead: for a humping bead the spread is the answer. In
-    the height panel, open triangles: the run means of the height from the mass per column (SPH window runs),
-    which a disordered frozen melt does not read low."""
+    deviation as error bar, beside the last sections' bead: for a humping bead the spread is the answer. Open
+    triangles: the run means of the width and height from the mass per column (SPH window runs), which a
+    disordered frozen melt does not read low and thin metal at the toes does not escape."""
     fig, axes = plt.subplots(1, 2, figsize=(9, 4.2))
     for ax, q in zip(axes, ("width", "height")):
         meas_all = balance[f"measured_{q}_mm"]
@@ -260,10 +260,10 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
         spread = _run_spread(errors, q)
         if spread is not None:
             top = np.nanmax([top, (errors[f"{q}_run_mean_mm"] + spread).max()])
-        mass = q == "height" and "height_mass_run_mean_mm" in errors
+        mass = f"{q}_mass_run_mean_mm" in errors
         if mass:
-            top = np.nanmax([top, (errors["height_mass_run_mean_mm"]
-                                   + errors["height_mass_run_sd_mm"].fillna(0.0)).max()])
+            top = np.nanmax([top, (errors[f"{q}_mass_run_mean_mm"]
+                                   + errors[f"{q}_mass_run_sd_mm"].fillna(0.0)).max()])
         lim = [0, 1.25 * max(meas_all.max(), top)]
         ax.plot(lim, lim, "k-", lw=1)
         ax.fill_between(lim, [v * 0.95 for v in lim], [v * 1.05 for v in lim], color="0.85", label="+-5 %")
@@ -292,12 +292,12 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
                 ax.errorbar(runs[f"{q}_meas_mm"] + 0.015 * lim[1], runs[f"{q}_run_mean_mm"],
                             yerr=_run_spread(runs, q), fmt="x",
                             color=f"C{k}", capsize=3, label=name + ", run mean +- sd of the sections")
-            runs = ok[ok["height_mass_run_mean_mm"].notna()] if mass else ok.iloc[:0]
+            runs = ok[ok[f"{q}_mass_run_mean_mm"].notna()] if mass else ok.iloc[:0]
             if len(runs):
-                # the height from the mass per column (it reads Table 1's bead at its height), further right
-                ax.errorbar(runs["height_meas_mm"] + 0.03 * lim[1], runs["height_mass_run_mean_mm"],
-                            yerr=runs["height_mass_run_sd_mm"].fillna(0.0), fmt="^", mfc="none", color=f"C{k}",
-                            capsize=3, label=name + ", height from the mass per column, mean +- sd of the sections")
+                # the width / height from the mass per column, further right
+                ax.errorbar(runs[f"{q}_meas_mm"] + 0.03 * lim[1], runs[f"{q}_mass_run_mean_mm"],
+                            yerr=runs[f"{q}_mass_run_sd_mm"].fillna(0.0), fmt="^", mfc="none", color=f"C{k}",
+                            capsize=3, label=name + f", {q} from the mass per column, mean +- sd of the sections")
             for _, r in ok.iterrows():
                 ax.annotate(f"m{r['mode']}", (r[f"{q}_meas_mm"], r[f"{q}_pred_mm"]), fontsize=7,
                             xytext=(3, 3), textcoords="offset points")

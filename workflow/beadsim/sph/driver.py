@@ -70,6 +70,7 @@ SECTION_SPREAD = {"bead_width_mm": "bead_width_sd_mm", "bead_height_mm": "bead_h
 RUN_MEANS = {"bead_width_mm": ("bead_width_run_mean_mm", "bead_width_run_sd_mm"),
              "bead_height_mm": ("bead_height_run_mean_mm", "bead_height_run_sd_mm"),
              "bead_height_mass_mm": ("bead_height_mass_run_mean_mm", "bead_height_mass_run_sd_mm"),
+             "bead_width_mass_mm": ("bead_width_mass_run_mean_mm", "bead_width_mass_run_sd_mm"),
              "mass_balance_ratio": ("mass_balance_run_mean", "mass_balance_run_sd")}
 
 
@@ -1601,7 +1602,7 @@ class BeadRun:
         """Bead cross-section now (moving window), for the steady-state test and the final average."""
         keys = ("bead_width_mm", "bead_height_mm", "bead_area_mm2", "contact_angle_deg", "mass_balance_ratio",
                 "penetration_depth_mm", "fusion_width_mm", "bead_top_phase", "bead_top_order",
-                "bead_height_mass_mm") + POOL_KEYS
+                "bead_height_mass_mm", "bead_width_mass_mm") + POOL_KEYS
         out = self._bead_metrics(self._supply_mm2())
         if "profile" in out:
             self.profiles = (self.profiles + [out["profile"]])[-int(self.p["bead_sections"]):]
@@ -1839,7 +1840,7 @@ class BeadRun:
             if self.geom.moving_window and checks and self.profiles:
                 # the mean of the last bead_sections cross-sections (0.05 s apart; three by default)
                 for key in ("mass_balance_ratio", "penetration_depth_mm", "fusion_width_mm", "bead_top_order",
-                            "bead_height_mass_mm"):
+                            "bead_height_mass_mm", "bead_width_mass_mm"):
                     out[key] = float(np.nanmean([c.get(key, np.nan) for c in checks]))
                 phases = _finite_values(checks, "bead_top_phase")
                 out["bead_top_phase"] = surface.circular_phase_mean(phases)[0] if len(phases) else np.nan
@@ -1927,7 +1928,8 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
     it held at t = 0, so it is exact in mass; in the moving window (the lattice moves through the slab) it
     counts the particles that came from the wire (``wire_origin``). Width, height, contact angle, pool and
     penetration come from :mod:`beadsim.sph.surface`; ``bead_height_mass_mm`` from the particles counted per
-    column down to the block's bottom face (:func:`surface.mass_height_profile`).
+    column down to the block's bottom face (:func:`surface.mass_height_profile`), and ``bead_width_mass_mm`` from
+    the same profile (:func:`surface.mass_width`).
     """
     out: dict = {}
     liquid = types == TYPE_LIQUID
@@ -1956,6 +1958,7 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
     # on the height map's bins: the same particles set the same grid of columns
     mass = surface.mass_height_profile(x[deposit], geom.dx, window, geom.z_lo)[1]
     out["bead_height_mass_mm"] = max(surface.smoothed_peak(mass), 0.0) * 1e3 if len(mass) else np.nan
+    out["bead_width_mass_mm"] = surface.mass_width(y_bins, mass, geom.dx) * 1e3 if len(mass) else np.nan
     out["profile"] = (y_bins, top, mass)
     out["bead_top_phase"], out["bead_top_order"] = surface.top_layer_registration(x[deposit], geom.dx, window)
     out["penetration_depth_mm"] = surface.penetration_depth(x, melted, geom.dx, window, z_surface=0.0)

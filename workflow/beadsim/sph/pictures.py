@@ -218,7 +218,7 @@ def section_figure(series, dx: float, result: dict, measured: tuple[float, float
         return "-" if v is None else f"{v:.2f}"
 
     title = (f"{note}; bead {mm('bead_width_mm')} x {mm('bead_height_mm')} mm (height map), "
-             f"{mm('bead_height_mass_mm')} mm high by mass"
+             f"{mm('bead_width_mass_mm')} x {mm('bead_height_mass_mm')} mm by mass"
              + (f"; Table 1 mode {mode}: {measured[0]:g} x {measured[1]:g} mm" if measured else ""))
     return section_picture(series["y_section"].values, series["section_height_map_mm"].values,
                            series["section_height_mass_mm"].values, dx, measured, title)

@@ -174,6 +174,17 @@ def mass_height_profile(pos, dx, x_window, z_base, z_surface=0.0, mask=None):
     return y_centres, z_base + table.mean(axis=0) * dx - z_surface
 
 
+def mass_width(y: np.ndarray, mass: np.ndarray, dx: float) -> float:
+    """Width (m) of the bead by mass: :func:`profile_metrics`' width rule (the run of bins above ``dx/2`` that
+    holds the highest bin, edges interpolated) applied to a :func:`mass_height_profile`.
+
+    The height map's width takes the median column top of each bin, so a bin where fewer than half the columns
+    hold metal reads bare however much metal its other columns hold; the mass per column counts it. For a
+    bead of particles stacked in columns (a lattice cap) both profiles are the same and so are both widths,
+    so :func:`lattice_cap_readings` is the like-with-like reference for this width too."""
+    return profile_metrics(np.asarray(y, dtype=float), np.asarray(mass, dtype=float), dx)["bead_width_mm"] * 1e-3
+
+
 def smoothed_peak(h: np.ndarray) -> float:
     """Highest value of a profile after a (1, 2, 1) / 4 running mean over its bins (missing bins count as 0):
     the height of :func:`mass_height_profile`, whose single bins scatter by about a third of a spacing in the
