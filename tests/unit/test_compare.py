@@ -81,9 +81,13 @@ def test_error_table_gives_the_run_means_beside_the_last_sections(experiments):
     assert t.loc["sph_run", "width_mass_run_mean_err_rel"] == pytest.approx((3.8 - w) / w)
     assert t.loc["sph_run", "width_mass_run_sd_mm"] == pytest.approx(0.7)
     assert t.loc["reduced_run", ["width_mass_pred_mm", "width_mass_run_mean_mm"]].isna().all()
-    for ax, q, top in zip(fig.axes, ("width", "height"), (3.8 + 0.7, 0.93 + 0.4)):
-        assert sum(f"{q} from the mass per column" in lab for lab in ax.get_legend_handles_labels()[1]) == 1
+    for ax, top in zip(fig.axes, (3.8 + 0.7, 0.93 + 0.4)):
+        assert sum("from the mass per column" in lab for lab in ax.get_legend_handles_labels()[1]) == 1
         assert ax.get_ylim()[1] >= top
+    # one legend for both panels, below them, each entry once
+    assert len(fig.legends) == 1 and all(ax.get_legend() is None for ax in fig.axes)
+    texts = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert len(texts) == len(set(texts)) and sum("from the mass per column" in t for t in texts) == 1
     for ax in fig.axes:  # one band per SPH spacing
         assert sum("read by the measure" in lab for lab in ax.get_legend_handles_labels()[1]) == 1
     # a dataset of reduced runs only has no run-mean variables at all

@@ -297,7 +297,7 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
                 # the width / height from the mass per column, further right
                 ax.errorbar(runs[f"{q}_meas_mm"] + 0.03 * lim[1], runs[f"{q}_mass_run_mean_mm"],
                             yerr=runs[f"{q}_mass_run_sd_mm"].fillna(0.0), fmt="^", mfc="none", color=f"C{k}",
-                            capsize=3, label=name + f", {q} from the mass per column, mean +- sd of the sections")
+                            capsize=3, label=name + ", from the mass per column, mean +- sd of the sections")
             for _, r in ok.iterrows():
                 ax.annotate(f"m{r['mode']}", (r[f"{q}_meas_mm"], r[f"{q}_pred_mm"]), fontsize=7,
                             xytext=(3, 3), textcoords="offset points")
@@ -307,8 +307,16 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
         ax.set_ylim(lim)
         ax.set_xlabel(f"measured bead {q} [mm]")
         ax.set_ylabel(f"predicted bead {q} [mm]")
-        ax.legend(fontsize=7)
+    # one legend for both panels, below them: inside the axes its long entries covered the markers and ran
+    # past the figure's edge
+    entries = {}
+    for ax in axes:
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            entries.setdefault(label, handle)
     fig.tight_layout()
+    if entries:
+        fig.legend(list(entries.values()), list(entries), loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=2,
+                   fontsize=7, frameon=False)
     return fig
 
 
