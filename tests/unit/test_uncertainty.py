@@ -57,3 +57,21 @@ def test_reduced_model_width_grows_with_beam_efficiency(tmp_path):
     ordered = samples.sort_values("param.beam_efficiency")
     assert np.all(np.diff(ordered["penetration_depth_mm"]) > 0)
     assert np.all(np.diff(ordered["bead_width_mm"]) >= 0)
+
+
+def test_uncertainty_plot_draws_every_band_with_one_legend_below():
+    import matplotlib.pyplot as plt
+
+    from beadsim.plots import uncertainty_plot
+
+    table = pd.DataFrame({"metric": ["bead_width_mm"] * 2 + ["bead_height_mm"] * 2, "mode": [1, 2, 1, 2],
+                          "p05": [3.0, 4.0, 0.6, 0.9], "p50": [3.5, 4.5, 0.7, 1.0], "p95": [4.0, 5.0, 0.8, 1.1],
+                          "nominal": [3.6, 4.4, 0.72, 1.05], "measured": [3.3, 3.6, 1.0, 0.7],
+                          "measured_unc": [0.1] * 4})
+    fig = uncertainty_plot(table)
+    assert len(fig.legends) == 1 and all(ax.get_legend() is None for ax in fig.axes)
+    assert [t.get_text() for t in fig.legends[0].get_texts()] == ["5-95 % band", "median", "nominal inputs",
+                                                                  "Table 1"]
+    for ax, (lo, hi) in zip(fig.axes, ((3.0, 5.0), (0.6, 1.1))):
+        assert ax.get_ylim()[0] <= lo - 1e-9 and ax.get_ylim()[1] >= hi + 1e-9
+    plt.close(fig)

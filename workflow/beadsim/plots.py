@@ -438,6 +438,8 @@ def uncertainty_plot(table: pd.DataFrame, metrics=("bead_width_mm", "bead_height
             ax.errorbar(x + 0.1, sub["measured"], yerr=sub["measured_unc"], fmt="ks", capsize=3, label="Table 1")
         ax.set_xticks(x, [f"mode {m}" for m in sub["mode"]])
         ax.set_ylabel(metric.replace("_mm", " [mm]").replace("_", " "))
-        ax.legend(fontsize=7)
     fig.tight_layout()
+    # one legend, below the panels (inside them it covered a band)
+    fig.legend(*axes[0][0].get_legend_handles_labels(), loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=4,
+               fontsize=7, frameon=False)
     return fig
