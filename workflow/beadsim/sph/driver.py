@@ -1958,7 +1958,7 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
     # on the height map's bins: the same particles set the same grid of columns
     mass = surface.mass_height_profile(x[deposit], geom.dx, window, geom.z_lo)[1]
     out["bead_height_mass_mm"] = max(surface.smoothed_peak(mass), 0.0) * 1e3 if len(mass) else np.nan
-    out["bead_width_mass_mm"] = surface.mass_width(y_bins, mass, geom.dx) * 1e3 if len(mass) else np.nan
+    out["bead_width_mass_mm"] = surface.mass_width(mass, geom.dx) * 1e3 if len(mass) else np.nan
     out["profile"] = (y_bins, top, mass)
     out["bead_top_phase"], out["bead_top_order"] = surface.top_layer_registration(x[deposit], geom.dx, window)
     out["penetration_depth_mm"] = surface.penetration_depth(x, melted, geom.dx, window, z_surface=0.0)

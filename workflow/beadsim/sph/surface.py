@@ -174,15 +174,16 @@ def mass_height_profile(pos, dx, x_window, z_base, z_surface=0.0, mask=None):
     return y_centres, z_base + table.mean(axis=0) * dx - z_surface
 
 
-def mass_width(y: np.ndarray, mass: np.ndarray, dx: float) -> float:
-    """Width (m) of the bead by mass: :func:`profile_metrics`' width rule (the run of bins above ``dx/2`` that
-    holds the highest bin, edges interpolated) applied to a :func:`mass_height_profile`.
+def mass_width(mass: np.ndarray, dx: float) -> float:
+    """Width (m) of the bead by mass: :func:`profile_metrics`' width rule (:func:`_profile_width`: the run of
+    bins above ``dx/2`` that holds the highest bin, edges interpolated) applied to a
+    :func:`mass_height_profile`.
 
     The height map's width takes the median column top of each bin, so a bin where fewer than half the columns
     hold metal reads bare however much metal its other columns hold; the mass per column counts it. For a
     bead of particles stacked in columns (a lattice cap) both profiles are the same and so are both widths,
     so :func:`lattice_cap_readings` is the like-with-like reference for this width too."""
-    return profile_metrics(np.asarray(y, dtype=float), np.asarray(mass, dtype=float), dx)["bead_width_mm"] * 1e-3
+    return _profile_width(np.asarray(mass, dtype=float), dx)[0]
 
 
 def smoothed_peak(h: np.ndarray) -> float:
@@ -285,20 +286,26 @@ def _edge_fraction(h: np.ndarray, inner: int, outer: int, threshold: float) -> f
     return float(np.clip((h_in - threshold) / (h_in - h_out), 0.0, 1.0)) if h_in > h_out else 0.5
 
 
+def _profile_width(h: np.ndarray, dx: float) -> tuple[float, slice]:
+    """Width (m) of a profile h(y) on bins of width dx, as :func:`bead_cross_section` defines it, and the run of
+    bins above ``dx/2`` it spans (empty: width 0)."""
+    threshold = 0.5 * dx
+    run = _bead_run(h, threshold)
+    n_bins = run.stop - run.start
+    if not n_bins:
+        return 0.0, run
+    ends = [_edge_fraction(h, run.start, run.start - 1, threshold),
+            _edge_fraction(h, run.stop - 1, run.stop, threshold)]
+    return (n_bins - 1 + sum(ends)) * dx, run
+
+
 def profile_metrics(y: np.ndarray, h: np.ndarray, dx: float) -> dict:
     """Width, height, area and contact angle of a height profile h(y) (m) on bins of width dx, as in
     :func:`bead_cross_section` (which applies it to one :func:`height_map`; the moving-window driver applies it
     to the mean of several maps taken at different times)."""
-    threshold = 0.5 * dx
-    run = _bead_run(h, threshold)
-    n_bins = run.stop - run.start
-    height = float(np.nanmax(h)) if n_bins else 0.0
+    width, run = _profile_width(h, dx)
+    height = float(np.nanmax(h)) if run.stop > run.start else 0.0
     area = float(np.nansum(np.clip(h, 0.0, None)) * dx)
-    width = 0.0
-    if n_bins:
-        ends = [_edge_fraction(h, run.start, run.start - 1, threshold),
-                _edge_fraction(h, run.stop - 1, run.stop, threshold)]
-        width = (n_bins - 1 + sum(ends)) * dx
     return {
         "bead_width_mm": width * 1e3,
         "bead_height_mm": max(height, 0.0) * 1e3,
