@@ -297,6 +297,11 @@ def test_moving_window_conserves_energy_and_feeds_substrate(tmp_path):
     # reaches beyond the bins that hold metal in the mean section
     held = np.flatnonzero(np.nan_to_num(h_mass) > 0)
     assert 0.8 * m["bead_width_mm"] < m["bead_width_mass_mm"] <= (held[-1] - held[0] + 1) * dx_mm + 1e-9
+    # the plate's own surface that melted lies inside the fused top, which counts the deposit's (measured: 2.40
+    # against 4.53 mm), and the toe overhang is half the width by mass beyond it (0.78 mm: the metal's 3.95 mm)
+    assert 0 < m["plate_fusion_width_mm"] <= m["fusion_width_mm"] + 1e-9
+    assert m["toe_overhang_mm"] == pytest.approx(0.5 * (m["bead_width_mass_mm"] - m["plate_fusion_width_mm"]),
+                                                 rel=1e-9)
     # resumed at its end (a forced rerun of a finished run resumes from its last checkpoint), the run reports
     # the same bead: the last sections' profiles are in the checkpoint, not only their scalar values
     again = run_case(params, tmp_path, resume=True)
@@ -377,7 +382,8 @@ def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_s
         section = {"mass_balance_ratio": ratio, "penetration_depth_mm": 0.1 * i, "fusion_width_mm": 3.0,
                    **surface.profile_metrics(y, h, dx), "profile": (yi, hi, 1.1 * np.nan_to_num(hi)),
                    "bead_top_phase": 0.45 * (-1) ** i, "bead_top_order": 0.1 * i,
-                   "bead_height_mass_mm": 1.1 * caps[i][1] * dx * 1e3, "bead_width_mass_mm": 1.2 * caps[i][0] * dx * 1e3}
+                   "bead_height_mass_mm": 1.1 * caps[i][1] * dx * 1e3, "bead_width_mass_mm": 1.2 * caps[i][0] * dx * 1e3,
+                   "plate_fusion_width_mm": 2.0 + 0.1 * i, "toe_overhang_mm": 0.2 * i}
         monkeypatch.setattr(run, "_bead_metrics", lambda supply, s=section: dict(s))
         run.series.append({"t": 0.05 * (i + 1), **run._bead_check()})
     m = run._metrics()
@@ -415,6 +421,12 @@ def test_window_bead_is_the_mean_of_the_last_sections(tmp_path, monkeypatch, n_s
     assert m["bead_width_mass_run_mean_mm"] == pytest.approx(np.mean(mass_widths[since]), rel=1e-12)
     assert m["bead_width_mass_run_sd_mm"] == pytest.approx(np.std(mass_widths[since], ddof=1), rel=1e-12)
     assert m["mass_balance_run_sd"] == pytest.approx(np.std(ratios[since], ddof=1), rel=1e-12)
+    plate, toe = np.array([2.0 + 0.1 * i for i in range(6)]), np.array([0.2 * i for i in range(6)])
+    assert m["plate_fusion_width_mm"] == pytest.approx(plate[last].mean(), rel=1e-12)
+    assert m["plate_fusion_width_run_mean_mm"] == pytest.approx(plate[since].mean(), rel=1e-12)
+    assert m["toe_overhang_mm"] == pytest.approx(toe[last].mean(), rel=1e-12)
+    assert m["toe_overhang_run_mean_mm"] == pytest.approx(toe[since].mean(), rel=1e-12)
+    assert m["toe_overhang_run_sd_mm"] == pytest.approx(np.std(toe[since], ddof=1), rel=1e-12)
     # the mean section the run keeps for its time series: both profiles averaged on the same aligned bins
     y_mean, h_map, h_mass = run.section
     on_y = np.isin(np.rint(y_mean / dx), np.rint(y / dx))

@@ -100,6 +100,12 @@ def test_section_figure_draws_the_run_against_the_measured_cap():
     assert labels[1].endswith(f"{1.1 * np.sum(h_map) * dx:.2f} mm2") and "3.3 x 1 mm" in labels[2]
     assert "Table 1 mode 1" in ax.get_title() and "3.20 x 0.80 mm" in ax.get_title()
     assert ax.get_xlim()[1] >= 1.65 and ax.get_ylim()[1] > 1.0
+    assert not any("plate surface melted" in label for label in labels)  # no width recorded: no bar
+    plt.close(fig)
+    result["metrics"]["plate_fusion_width_mm"] = 2.6  # the plate melted narrower than the metal lies
+    fig = section_figure(ts, dx, result, (3.3, 1.0), 1)
+    bars = [line for line in fig.axes[0].get_lines() if line.get_label().startswith("plate surface melted, 2.60 mm")]
+    assert len(bars) == 1 and list(bars[0].get_xdata()) == [-1.3, 1.3] and list(bars[0].get_ydata()) == [0, 0]
     plt.close(fig)
     failed = section_figure(None, dx, {"run_id": "m2", "status": "failed", "reason": "NaN at t=0.1"})
     assert "no bead cross-section" in failed.axes[0].texts[0].get_text()

@@ -209,6 +209,22 @@ def test_fusion_width_between_lattice_steps():
     assert fusion_width(pos, melted, DX, WINDOW) == pytest.approx(3.1, abs=1e-9)
 
 
+def test_plate_fusion_width_leaves_the_deposit_out():
+    """A bead 2 mm wide and three layers thick, all of it once molten, on a plate whose top melted 1.2 mm wide
+    under it: the fused top seen from above is the bead's 2 mm, the plate's fused surface 1.2 mm; with the plate
+    melted 3 mm wide (wider than the bead) both read 3 mm."""
+    from beadsim.sph.surface import fusion_width, plate_fusion_width
+
+    plate = lattice((0.0, -3e-3, -1e-3), (2e-3, 3e-3, 0.0))
+    bead = lattice((0.0, -1e-3, 0.0), (2e-3, 1e-3, 3 * DX))
+    pos = np.vstack([plate, bead])
+    for half, fused, plate_fused in ((0.6e-3, 2.0, 1.2), (1.5e-3, 3.0, 3.0)):
+        melted = (pos[:, 2] > 0) | ((np.abs(pos[:, 1]) < half) & (pos[:, 2] > -3 * DX))
+        assert fusion_width(pos, melted, DX, WINDOW) == pytest.approx(fused, abs=1e-9)
+        assert plate_fusion_width(pos, melted, DX, WINDOW) == pytest.approx(plate_fused, abs=1e-9)
+    assert plate_fusion_width(pos, pos[:, 2] > 0, DX, WINDOW) == 0.0  # metal on a plate that never melted
+
+
 def test_mean_profile_aligns_maps_on_whole_bins():
     """Maps taken at different times: the melt shifts the lattice phase by a fraction of a spacing and a stray
     particle widens the extent; the mean is bin by bin on the union, a map on another lattice is left out."""

@@ -51,7 +51,19 @@ METRICS: dict[str, tuple[str, str]] = {
     "aspect_ratio": ("1", "bead height / width"),
     "contact_angle_deg": ("degree", "bead contact angle"),
     "penetration_depth_mm": ("mm", "remelt depth into substrate"),
-    "fusion_width_mm": ("mm", "width of the fused (ever-molten) top surface"),
+    "fusion_width_mm": ("mm", "width of the fused (ever-molten) top surface, the deposit's top included"),
+    "plate_fusion_width_mm": ("mm", "width of the plate's own top surface that melted (the deposit left out; SPH)"),
+    "plate_fusion_width_run_mean_mm": ("mm", "width of the plate's surface that melted, mean of the "
+                                       "cross-sections since the wire's metal arrived (SPH window)"),
+    "plate_fusion_width_run_sd_mm": ("mm", "width of the plate's surface that melted, standard deviation of the "
+                                     "cross-sections since the wire's metal arrived (SPH window)"),
+    "toe_overhang_mm": ("mm", "how far the bead's metal (by mass, half a spacing thick) reaches past the melted "
+                        "plate on each side: (bead_width_mass - plate_fusion_width) / 2; > 0: the toes lie on "
+                        "plate that never melted (SPH)"),
+    "toe_overhang_run_mean_mm": ("mm", "toe overhang, mean of the cross-sections since the wire's metal arrived "
+                                 "(SPH window)"),
+    "toe_overhang_run_sd_mm": ("mm", "toe overhang, standard deviation of the cross-sections since the wire's "
+                               "metal arrived (SPH window)"),
     "pool_length_mm": ("mm", "melt pool length"),
     "pool_width_mm": ("mm", "melt pool width"),
     "pool_depth_mm": ("mm", "melt pool depth"),

@@ -71,6 +71,8 @@ RUN_MEANS = {"bead_width_mm": ("bead_width_run_mean_mm", "bead_width_run_sd_mm")
              "bead_height_mm": ("bead_height_run_mean_mm", "bead_height_run_sd_mm"),
              "bead_height_mass_mm": ("bead_height_mass_run_mean_mm", "bead_height_mass_run_sd_mm"),
              "bead_width_mass_mm": ("bead_width_mass_run_mean_mm", "bead_width_mass_run_sd_mm"),
+             "plate_fusion_width_mm": ("plate_fusion_width_run_mean_mm", "plate_fusion_width_run_sd_mm"),
+             "toe_overhang_mm": ("toe_overhang_run_mean_mm", "toe_overhang_run_sd_mm"),
              "mass_balance_ratio": ("mass_balance_run_mean", "mass_balance_run_sd")}
 
 
@@ -1602,7 +1604,7 @@ class BeadRun:
         """Bead cross-section now (moving window), for the steady-state test and the final average."""
         keys = ("bead_width_mm", "bead_height_mm", "bead_area_mm2", "contact_angle_deg", "mass_balance_ratio",
                 "penetration_depth_mm", "fusion_width_mm", "bead_top_phase", "bead_top_order",
-                "bead_height_mass_mm", "bead_width_mass_mm") + POOL_KEYS
+                "bead_height_mass_mm", "bead_width_mass_mm", "plate_fusion_width_mm", "toe_overhang_mm") + POOL_KEYS
         out = self._bead_metrics(self._supply_mm2())
         if "profile" in out:
             self.profiles = (self.profiles + [out["profile"]])[-int(self.p["bead_sections"]):]
@@ -1687,7 +1689,9 @@ class BeadRun:
                  "pool_x_min": "m", "pool_x_max": "m", "pool_y_abs_max": "m", "wire_z_min": "m", "wire_tip_s": "m",
                  "melt_z_min": "m", "energy_error": "1", "bead_width_mm": "mm",
                  "bead_height_mm": "mm", "bead_area_mm2": "mm2", "contact_angle_deg": "degree",
-                 "penetration_depth_mm": "mm", "fusion_width_mm": "mm", "pool_length_mm": "mm",
+                 "penetration_depth_mm": "mm", "fusion_width_mm": "mm", "plate_fusion_width_mm": "mm",
+                 "toe_overhang_mm": "mm", "bead_height_mass_mm": "mm", "bead_width_mass_mm": "mm",
+                 "pool_length_mm": "mm",
                  "pool_width_mm": "mm", "pool_depth_mm": "mm", "pool_volume_mm3": "mm3"}
         for k in ds.data_vars:
             ds[k].attrs["units"] = "J" if k.startswith("E_") else units.get(k, "1")
@@ -1840,7 +1844,7 @@ class BeadRun:
             if self.geom.moving_window and checks and self.profiles:
                 # the mean of the last bead_sections cross-sections (0.05 s apart; three by default)
                 for key in ("mass_balance_ratio", "penetration_depth_mm", "fusion_width_mm", "bead_top_order",
-                            "bead_height_mass_mm", "bead_width_mass_mm"):
+                            "bead_height_mass_mm", "bead_width_mass_mm", "plate_fusion_width_mm", "toe_overhang_mm"):
                     out[key] = float(np.nanmean([c.get(key, np.nan) for c in checks]))
                 phases = _finite_values(checks, "bead_top_phase")
                 out["bead_top_phase"] = surface.circular_phase_mean(phases)[0] if len(phases) else np.nan
@@ -1929,7 +1933,8 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
     counts the particles that came from the wire (``wire_origin``). Width, height, contact angle, pool and
     penetration come from :mod:`beadsim.sph.surface`; ``bead_height_mass_mm`` from the particles counted per
     column down to the block's bottom face (:func:`surface.mass_height_profile`), and ``bead_width_mass_mm`` from
-    the same profile (:func:`surface.mass_width`).
+    the same profile (:func:`surface.mass_width`); ``toe_overhang_mm`` is half of that width less
+    ``plate_fusion_width_mm`` (:func:`surface.plate_fusion_width`, the plate's surface that melted).
     """
     out: dict = {}
     liquid = types == TYPE_LIQUID
@@ -1963,6 +1968,9 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
     out["bead_top_phase"], out["bead_top_order"] = surface.top_layer_registration(x[deposit], geom.dx, window)
     out["penetration_depth_mm"] = surface.penetration_depth(x, melted, geom.dx, window, z_surface=0.0)
     out["fusion_width_mm"] = surface.fusion_width(x[deposit], melted[deposit], geom.dx, window, z_surface=0.0)
+    out["plate_fusion_width_mm"] = surface.plate_fusion_width(x[deposit], melted[deposit], geom.dx, window)
+    # how far the metal (dx/2 thick) reaches past the melted plate on each side: > 0, toes on unmelted plate
+    out["toe_overhang_mm"] = 0.5 * (out["bead_width_mass_mm"] - out["plate_fusion_width_mm"])
     if out.get("bead_width_mm"):
         out["aspect_ratio"] = out["bead_height_mm"] / out["bead_width_mm"]
     log.info("bead window %.2f-%.2f mm: net added area %.3g mm2 (wire %.3g mm2, ratio %.3f)",

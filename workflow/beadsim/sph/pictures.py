@@ -155,7 +155,8 @@ def cap_outline(width: float, height: float, n: int = 101) -> tuple[np.ndarray, 
 
 
 def section_picture(y: np.ndarray, h_map: np.ndarray, h_mass: np.ndarray, dx: float,
-                    measured: tuple[float, float] | None = None, title: str = "") -> plt.Figure:
+                    measured: tuple[float, float] | None = None, title: str = "",
+                    plate_fused: float | None = None) -> plt.Figure:
     """The bead's cross-section as the run measured it, against the measured bead.
 
     Parameters
@@ -168,6 +169,9 @@ def section_picture(y: np.ndarray, h_map: np.ndarray, h_mass: np.ndarray, dx: fl
         Particle spacing (the bins' width).
     measured : (width, height), mm, optional
         The measured bead (Table 1), drawn as a circular cap on the bead's axis.
+    plate_fused : float, mm, optional
+        Width of the plate's surface that melted (``plate_fusion_width_mm``), drawn as a bar on the plate
+        centred on the beam's axis: metal beyond it lies on plate that never melted.
     """
     fig, ax = plt.subplots(figsize=(8, 3.2))
     ax.axhline(0.0, color="0.6", lw=0.8)
@@ -176,6 +180,9 @@ def section_picture(y: np.ndarray, h_map: np.ndarray, h_mass: np.ndarray, dx: fl
     if np.isfinite(h_mass).any():
         area = np.nansum(np.clip(h_mass, 0, None)) * dx
         ax.plot(y, h_mass, "o-", ms=3, color="C1", label=f"particles per column (mass), {area:.2f} mm2")
+    if plate_fused is not None and np.isfinite(plate_fused) and plate_fused > 0:
+        ax.plot([-plate_fused / 2, plate_fused / 2], [0.0, 0.0], color="C3", lw=4, solid_capstyle="butt",
+                label=f"plate surface melted, {plate_fused:.2f} mm (on the beam's axis)")
     if measured is not None:
         w, h = measured
         yc, zc = cap_outline(w, h)
@@ -221,4 +228,5 @@ def section_figure(series, dx: float, result: dict, measured: tuple[float, float
              f"{mm('bead_width_mass_mm')} x {mm('bead_height_mass_mm')} mm by mass"
              + (f"; Table 1 mode {mode}: {measured[0]:g} x {measured[1]:g} mm" if measured else ""))
     return section_picture(series["y_section"].values, series["section_height_map_mm"].values,
-                           series["section_height_mass_mm"].values, dx, measured, title)
+                           series["section_height_mass_mm"].values, dx, measured, title,
+                           plate_fused=m.get("plate_fusion_width_mm"))

@@ -551,6 +551,26 @@ def fusion_width(pos, melted_mask, dx, x_window, z_surface=0.0):
     return float(frac[run].sum()) * dx * 1e3
 
 
+def plate_fusion_width(pos, melted_mask, dx, x_window, z_surface=0.0):
+    """Width (mm) of the plate's own top surface that melted: :func:`fusion_width` of the particles below
+    ``z_surface`` alone.
+
+    :func:`fusion_width` counts a column fused where its top particle was ever liquid, and every deposited
+    particle was, so it reads the deposit's footprint wherever the deposit is wider than the melted plate. This
+    leaves the deposit out: it is the width over which the pool melted the plate (the fusion line where it meets
+    the plate's surface). Set beside the bead's width it says whether the bead is fused over its whole base:
+    metal wider than it lies on plate that never melted (its toes are not fused to the plate).
+
+    Parameters
+    ----------
+    pos, melted_mask, dx, x_window, z_surface
+        As for :func:`fusion_width` (pass every particle but the wire's; the deposit is dropped here).
+    """
+    pos = np.asarray(pos, dtype=float).reshape(-1, 3)
+    below = pos[:, 2] < z_surface
+    return fusion_width(pos[below], np.asarray(melted_mask, dtype=bool)[below], dx, x_window, z_surface)
+
+
 def _crossing(coord: np.ndarray, value: np.ndarray, level: float) -> tuple[float, float]:
     """Outermost points where a sampled profile ``value(coord)`` (coord ascending) crosses ``level``, by
     linear interpolation between the last sample at or above ``level`` and its neighbour outside (the sample
