@@ -125,6 +125,9 @@ class Numerics:
     tait_rho0 : reference density of the Tait equation (kg/m^3): rho, or lower with surface tension
     solid_tait_rho0 : that of the solid particle types (``wetting_pressure_balance``; else tait_rho0)
     cohesion : the :class:`beadsim.sph.tension.CohesionModel` when surface tension is on, else None
+    plate_cohesion : with ``plate_wetting_ratio``, the model whose liquid-solid strength acts between the melt
+        and the plate that never melted (type substrate), else None
+    plate_tait_rho0 : the plate's Tait reference density (``wetting_pressure_balance`` at the plate's ratio)
     height_function : surface tension acts (also) through the height-function surface force
     height_function_sigma : the share of sigma it carries (N/m)
     wetting_deg : the contact angle set (degree): ``wetting_angle_deg`` or the material's
@@ -140,6 +143,8 @@ class Numerics:
     tait_rho0: float
     solid_tait_rho0: float
     cohesion: object = None
+    plate_cohesion: object = None
+    plate_tait_rho0: float = 0.0
     height_function: bool = False
     height_function_sigma: float = 0.0
     wetting_deg: float = 0.0
@@ -194,9 +199,15 @@ def choose_numerics(params: dict, mat: Material, geom: SceneGeometry) -> Numeric
             # metal's); wetting_pressure_balance removes the cause (tension.CohesionModel.solid_tait_rho0)
             log.warning("wetting ratio %.2f < 1: the melt next to solid is cohered less than the shifted Tait "
                         "pressure needs and expands; set wetting_pressure_balance", cohesion.wetting_ratio)
+    plate, plate_rho0 = None, solid_tait_rho0
+    if cohesion is not None and params["plate_wetting_ratio"] > 0:
+        plate = dataclasses.replace(cohesion, s_ls=params["plate_wetting_ratio"] * cohesion.s_ll)
+        if params["wetting_pressure_balance"]:
+            plate_rho0 = plate.solid_tait_rho0(mat, c0)
     dt = params["dt_factor"] * min(limits.values())
     return Numerics(dx=dx, h=h, mass=mat.rho * dx ** 3, c0=c0, dt=dt, limits=limits, expected_speed=v_exp,
                     tait_rho0=tait_rho0, solid_tait_rho0=solid_tait_rho0, cohesion=cohesion, height_function=hf,
+                    plate_cohesion=plate, plate_tait_rho0=plate_rho0,
                     height_function_sigma=mat.surface_tension * (1.0 - share) if hf else 0.0, wetting_deg=angle)
 
 
@@ -843,11 +854,17 @@ class BeadRun:
         else:
             styles = ["sph/taitwater"]
             tail = f"{c0:.9g} {self.p['artificial_viscosity']:.9g}"
-        pairs = fluid_pair_types(self.p["fluid_pairs_only"], self.num.solid_tait_rho0 != self.num.tait_rho0)
-        # the style takes each type's Tait reference density from the pair_coeff lines whose first type it is
-        coeffs = [f"pair_coeff {i} {j} {styles[0]} "
-                  f"{self.num.tait_rho0 if i == '*' or int(i) in FLUID_TYPES else self.num.solid_tait_rho0:.9g} "
-                  f"{tail} {h if on else 0.0:.9g}" for i, j, on in pairs]
+        num = self.num
+        per_type = num.solid_tait_rho0 != num.tait_rho0 or num.plate_cohesion is not None
+        pairs = fluid_pair_types(self.p["fluid_pairs_only"], per_type)
+
+        def rho0(i: str) -> float:  # the style takes each type's Tait reference density from the pair_coeff
+            if i == "*" or int(i) in FLUID_TYPES:  # lines whose first type it is
+                return num.tait_rho0
+            return num.plate_tait_rho0 if num.plate_cohesion is not None and int(i) == TYPE_SUBSTRATE \
+                else num.solid_tait_rho0
+
+        coeffs = [f"pair_coeff {i} {j} {styles[0]} {rho0(i):.9g} {tail} {h if on else 0.0:.9g}" for i, j, on in pairs]
         styles.append("sph/heatconduction")
         coeffs.append(f"pair_coeff * * sph/heatconduction {self.mat.diffusivity:.9g} {h:.9g}")
         not_liquid = (TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED, TYPE_FALLING)
@@ -868,6 +885,10 @@ class BeadRun:
             styles.append(model.pair_style_tokens())
             solid_types = [t for t in not_liquid if t not in FLUID_TYPES]
             coeffs += model.pair_coeff_commands(list(FLUID_TYPES), solid_types, table_file=self.out / "tension.table")
+            if num.plate_cohesion is not None:  # the plate that never melted: its own liquid-solid strength
+                lines = num.plate_cohesion.pair_coeff_commands(list(FLUID_TYPES), [TYPE_SUBSTRATE],
+                                                               table_file=self.out / "tension_plate.table")
+                coeffs += [line for line in lines if str(TYPE_SUBSTRATE) in line.split()[1:3]]
         return styles, coeffs
 
     def _define_physics(self) -> None:

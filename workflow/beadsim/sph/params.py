@@ -50,6 +50,12 @@ SPH_PARAMETERS: list[Param] = [
           "liquid-solid cohesion across the interface ((2 r - 1) times the liquid's background pressure; "
           "tension.CohesionModel.solid_tait_rho0), so that the melt beside solid does not expand; no effect at "
           "ratio 1", short="wpb", models=_SPH, long_name="wetting pressure balance"),
+    Param("plate_wetting_ratio", "number", 0.0, "1", "surface tension (pairwise): cohesion between the melt and "
+          "the plate that never melted, as a ratio s_lp / s_ll (0: as between the melt and every other solid, "
+          "set by wetting_angle_deg). The paper: where the beam melts the substrate's surface 'the best wetting "
+          "takes place'; a ratio below that of wetting_angle_deg wets the melted metal better than the cold "
+          "plate (ridges: 0.5 / 0.6 / 0.8 give 85 / 75 / 52 degree, tension.py)", minimum=0, maximum=1.3,
+          short="pwr", models=_SPH, long_name="plate wetting ratio"),
     Param("latent_heat", "boolean", False, "", "latent heat of fusion as an effective heat capacity over "
           "mushy_range_K above T_melt; off to match the paper", short="lh", models=_SPH),
     Param("mushy_range_K", "number", 50.0, "K", "temperature range over which the latent heat is released "
