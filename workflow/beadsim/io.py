@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import tempfile
 from pathlib import Path
@@ -35,7 +36,7 @@ def write_text(path, text: str) -> None:
 
 
 def write_json(path, obj) -> None:
-    """Atomically write JSON (indented, NaN as null)."""
+    """Atomically write JSON (indented; NaN and infinities as null, which strict JSON readers accept)."""
     write_text(path, json.dumps(_clean(obj), indent=2, sort_keys=False) + "\n")
 
 
@@ -52,7 +53,7 @@ def save_figure(fig, path, **kw) -> None:
 
 
 def _clean(obj):
-    if isinstance(obj, float) and obj != obj:
+    if isinstance(obj, float) and not math.isfinite(obj):
         return None
     if isinstance(obj, dict):
         return {str(k): _clean(v) for k, v in obj.items()}

@@ -2049,11 +2049,7 @@ def run_case(params: dict, outdir: Path, progress=None, resume: bool = False,
     run.close()
     metrics["wall_time_s"] = time.perf_counter() - run.t0_wall
     if run.rank0:
-        write_metrics(outdir / "metrics.json", metrics)
+        io.write_json(outdir / "metrics.json", metrics)
     return metrics
 
 
-def write_metrics(path: Path, metrics: dict) -> None:
-    """Write the metrics as JSON (NaN and infinities as null), atomically."""
-    io.write_text(path, json.dumps(
-        {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in metrics.items()}, indent=1))
