@@ -551,3 +551,49 @@ def test_table_file_is_whole_while_another_rank_rewrites_it(tmp_path):
     assert writer.returncode == 0
     assert len(reads) > 20
     assert sum(r != whole for r in reads) == 0
+
+
+def test_plate_wetting_ratio_gives_the_unmelted_plate_its_own_cohesion(tmp_path):
+    """``plate_wetting_ratio``: the melt's cohesion with the plate that never melted (type substrate) has its own
+    strength, read from a second table whose liquid-solid section is that ratio of the liquid-liquid one; under
+    the wetting pressure balance the plate's Tait reference density puts it at (2 r - 1) times the liquid's
+    background pressure (zero at r = 0.5: rho0 = rho); melted metal keeps the ratio of wetting_angle_deg; a short
+    bead runs with the energy ledger closed."""
+    from beadsim.bench import mode_params
+    from beadsim.sph.driver import run_case
+    from beadsim.sph.scene import TYPE_LIQUID, TYPE_RESOLIDIFIED, TYPE_SUBSTRATE
+
+    p = mode_params(1, resolution_mm=0.5, domain="window", sim_time_s=0.03, surface_tension=True,
+                    artificial_viscosity=0.2, wetting_pressure_balance=True, wetting_angle_deg=72.7,
+                    plate_wetting_ratio=0.5, wire_feed_start="immediate")
+    m = run_case(p, tmp_path)
+    assert abs(m["energy_balance_error"]) < 1e-3
+
+    def forces(path):
+        out, key = {}, None
+        for line in path.read_text().splitlines():
+            words = line.split()
+            if len(words) == 1:
+                key, out[words[0]] = words[0], []
+            elif len(words) == 4 and key:
+                out[key].append(float(words[3]))
+        return {k: np.array(v) for k, v in out.items()}
+
+    own, plate = forces(tmp_path / "tension.table"), forces(tmp_path / "tension_plate.table")
+    np.testing.assert_allclose(plate["LL"], own["LL"], rtol=1e-12)
+    np.testing.assert_allclose(plate["LS"], 0.5 * plate["LL"], rtol=1e-9)
+    np.testing.assert_allclose(own["LS"], 0.8 * own["LL"], rtol=0.02)  # 72.7 deg on the balanced table
+    deck = (tmp_path / "deck.in").read_text().splitlines()
+    tables = {}  # the last pair_coeff of a type pair in the table sub-style is the one LAMMPS keeps
+    rho0 = {}  # a type's Tait reference density, from the sph/taitwater line whose first type it is
+    for line in deck:
+        words = line.split()
+        if words[:1] == ["pair_coeff"] and words[3] == "table":
+            tables[(int(words[1]), int(words[2]))] = (words[4].rsplit("/", 1)[-1], words[5])
+        if words[:1] == ["pair_coeff"] and words[3] == "sph/taitwater" and words[1] == words[2]:
+            rho0[int(words[1])] = float(words[4])
+    assert tables[(TYPE_SUBSTRATE, TYPE_LIQUID)] == ("tension_plate.table", "LS")
+    assert tables[(TYPE_LIQUID, TYPE_RESOLIDIFIED)] == ("tension.table", "LS")
+    assert tables[(TYPE_LIQUID, TYPE_LIQUID)] == ("tension.table", "LL")
+    assert rho0[TYPE_SUBSTRATE] == pytest.approx(TI.rho, rel=1e-9)
+    assert rho0[TYPE_RESOLIDIFIED] < TI.rho and rho0[TYPE_LIQUID] < rho0[TYPE_RESOLIDIFIED]
