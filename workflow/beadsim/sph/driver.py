@@ -200,6 +200,9 @@ def choose_numerics(params: dict, mat: Material, geom: SceneGeometry) -> Numeric
             log.warning("wetting ratio %.2f < 1: the melt next to solid is cohered less than the shifted Tait "
                         "pressure needs and expands; set wetting_pressure_balance", cohesion.wetting_ratio)
     plate, plate_rho0 = None, solid_tait_rho0
+    if cohesion is None and params["plate_wetting_ratio"] > 0:
+        log.warning("plate_wetting_ratio %g acts through the pairwise cohesion, which is off here: ignored",
+                    params["plate_wetting_ratio"])
     if cohesion is not None and params["plate_wetting_ratio"] > 0:
         plate = dataclasses.replace(cohesion, s_ls=params["plate_wetting_ratio"] * cohesion.s_ll)
         if params["wetting_pressure_balance"]:
@@ -864,7 +867,8 @@ class BeadRun:
             return num.plate_tait_rho0 if num.plate_cohesion is not None and int(i) == TYPE_SUBSTRATE \
                 else num.solid_tait_rho0
 
-        coeffs = [f"pair_coeff {i} {j} {styles[0]} {rho0(i):.9g} {tail} {h if on else 0.0:.9g}" for i, j, on in pairs]
+        coeffs = [f"pair_coeff {i} {j} {styles[0]} {rho0(i):.9g} {tail} {h if on else 0.0:.9g}"
+                  for i, j, on in pairs]
         styles.append("sph/heatconduction")
         coeffs.append(f"pair_coeff * * sph/heatconduction {self.mat.diffusivity:.9g} {h:.9g}")
         not_liquid = (TYPE_SUBSTRATE, TYPE_WIRE, TYPE_RESOLIDIFIED, TYPE_FALLING)
@@ -1625,7 +1629,8 @@ class BeadRun:
         """Bead cross-section now (moving window), for the steady-state test and the final average."""
         keys = ("bead_width_mm", "bead_height_mm", "bead_area_mm2", "contact_angle_deg", "mass_balance_ratio",
                 "penetration_depth_mm", "fusion_width_mm", "bead_top_phase", "bead_top_order",
-                "bead_height_mass_mm", "bead_width_mass_mm", "plate_fusion_width_mm", "toe_overhang_mm") + POOL_KEYS
+                "bead_height_mass_mm", "bead_width_mass_mm", "plate_fusion_width_mm",
+                "toe_overhang_mm") + POOL_KEYS
         out = self._bead_metrics(self._supply_mm2())
         if "profile" in out:
             self.profiles = (self.profiles + [out["profile"]])[-int(self.p["bead_sections"]):]
@@ -1865,7 +1870,8 @@ class BeadRun:
             if self.geom.moving_window and checks and self.profiles:
                 # the mean of the last bead_sections cross-sections (0.05 s apart; three by default)
                 for key in ("mass_balance_ratio", "penetration_depth_mm", "fusion_width_mm", "bead_top_order",
-                            "bead_height_mass_mm", "bead_width_mass_mm", "plate_fusion_width_mm", "toe_overhang_mm"):
+                            "bead_height_mass_mm", "bead_width_mass_mm", "plate_fusion_width_mm",
+                            "toe_overhang_mm"):
                     out[key] = float(np.nanmean([c.get(key, np.nan) for c in checks]))
                 phases = _finite_values(checks, "bead_top_phase")
                 out["bead_top_phase"] = surface.circular_phase_mean(phases)[0] if len(phases) else np.nan
