@@ -5,6 +5,15 @@ A model returns a dict whose keys are names from this table (missing keys become
 
 from __future__ import annotations
 
+
+def _run_stats(mean_key: str, sd_key: str, units: str, what: str, note: str = "") -> dict[str, tuple[str, str]]:
+    """Entries for a per-section value's mean and standard deviation over the cross-sections since the wire's
+    metal arrived (SPH window; ``driver.RUN_MEANS``), ``note`` added to the mean's."""
+    since = "the cross-sections since the wire's metal arrived (SPH window"
+    return {mean_key: (units, f"{what}, mean of {since}{'; ' + note if note else ''})"),
+            sd_key: (units, f"{what}, standard deviation of {since})")}
+
+
 METRICS: dict[str, tuple[str, str]] = {
     # name: (units, long_name)
     "bead_width_mm": ("mm", "bead width"),
@@ -14,32 +23,20 @@ METRICS: dict[str, tuple[str, str]] = {
     "bead_height_sd_mm": ("mm", "bead height, standard deviation of the averaged cross-sections (SPH window)"),
     "mass_balance_sd": ("1", "mass balance ratio, standard deviation of the averaged cross-sections (SPH window)"),
     "bead_samples": ("1", "bead cross-sections averaged into the bead metrics (SPH moving window)"),
-    "bead_width_run_mean_mm": ("mm", "bead width, mean of the cross-sections since the wire's metal arrived "
-                               "(SPH window; over the humps of a humping bead)"),
-    "bead_width_run_sd_mm": ("mm", "bead width, standard deviation of the cross-sections since the wire's metal "
-                             "arrived (SPH window)"),
-    "bead_height_run_mean_mm": ("mm", "bead height, mean of the cross-sections since the wire's metal arrived "
-                                "(SPH window)"),
-    "bead_height_run_sd_mm": ("mm", "bead height, standard deviation of the cross-sections since the wire's "
-                              "metal arrived (SPH window)"),
+    **_run_stats("bead_width_run_mean_mm", "bead_width_run_sd_mm", "mm", "bead width",
+                 "over the humps of a humping bead"),
+    **_run_stats("bead_height_run_mean_mm", "bead_height_run_sd_mm", "mm", "bead height"),
     "bead_height_mass_mm": ("mm", "bead height from the mass per column: peak of the (1, 2, 1) / 4 running mean "
                             "of the particles counted per column at the lattice's density (SPH; mean of the "
                             "averaged cross-sections in a window run)"),
-    "bead_height_mass_run_mean_mm": ("mm", "bead height from the mass per column, mean of the cross-sections since "
-                                     "the wire's metal arrived (SPH window)"),
-    "bead_height_mass_run_sd_mm": ("mm", "bead height from the mass per column, standard deviation of the "
-                                   "cross-sections since the wire's metal arrived (SPH window)"),
+    **_run_stats("bead_height_mass_run_mean_mm", "bead_height_mass_run_sd_mm", "mm",
+                 "bead height from the mass per column"),
     "bead_width_mass_mm": ("mm", "bead width from the mass per column: where the particles counted per column "
                            "at the lattice's density reach half a spacing, edges interpolated (SPH; mean of the "
                            "averaged cross-sections in a window run)"),
-    "bead_width_mass_run_mean_mm": ("mm", "bead width from the mass per column, mean of the cross-sections since "
-                                    "the wire's metal arrived (SPH window)"),
-    "bead_width_mass_run_sd_mm": ("mm", "bead width from the mass per column, standard deviation of the "
-                                  "cross-sections since the wire's metal arrived (SPH window)"),
-    "mass_balance_run_mean": ("1", "mass balance ratio, mean of the cross-sections since the wire's metal "
-                              "arrived (SPH window)"),
-    "mass_balance_run_sd": ("1", "mass balance ratio, standard deviation of the cross-sections since the wire's "
-                            "metal arrived (SPH window)"),
+    **_run_stats("bead_width_mass_run_mean_mm", "bead_width_mass_run_sd_mm", "mm",
+                 "bead width from the mass per column"),
+    **_run_stats("mass_balance_run_mean", "mass_balance_run_sd", "1", "mass balance ratio"),
     "bead_run_from_s": ("s", "time of the first cross-section carrying the wire's metal (mass balance within "
                         "steady_tolerance of 1; SPH window)"),
     "bead_run_sections": ("1", "cross-sections in the run means (SPH window)"),
@@ -53,17 +50,12 @@ METRICS: dict[str, tuple[str, str]] = {
     "penetration_depth_mm": ("mm", "remelt depth into substrate"),
     "fusion_width_mm": ("mm", "width of the fused (ever-molten) top surface, the deposit's top included"),
     "plate_fusion_width_mm": ("mm", "width of the plate's own top surface that melted (the deposit left out; SPH)"),
-    "plate_fusion_width_run_mean_mm": ("mm", "width of the plate's surface that melted, mean of the "
-                                       "cross-sections since the wire's metal arrived (SPH window)"),
-    "plate_fusion_width_run_sd_mm": ("mm", "width of the plate's surface that melted, standard deviation of the "
-                                     "cross-sections since the wire's metal arrived (SPH window)"),
+    **_run_stats("plate_fusion_width_run_mean_mm", "plate_fusion_width_run_sd_mm", "mm",
+                 "width of the plate's surface that melted"),
     "toe_overhang_mm": ("mm", "how far the bead's metal (by mass, half a spacing thick) reaches past the melted "
                         "plate on each side: (bead_width_mass - plate_fusion_width) / 2; > 0: the toes lie on "
                         "plate that never melted (SPH)"),
-    "toe_overhang_run_mean_mm": ("mm", "toe overhang, mean of the cross-sections since the wire's metal arrived "
-                                 "(SPH window)"),
-    "toe_overhang_run_sd_mm": ("mm", "toe overhang, standard deviation of the cross-sections since the wire's "
-                               "metal arrived (SPH window)"),
+    **_run_stats("toe_overhang_run_mean_mm", "toe_overhang_run_sd_mm", "mm", "toe overhang"),
     "pool_length_mm": ("mm", "melt pool length"),
     "pool_width_mm": ("mm", "melt pool width"),
     "pool_depth_mm": ("mm", "melt pool depth"),
