@@ -54,7 +54,8 @@ METRICS: dict[str, tuple[str, str]] = {
                  "width of the plate's surface that melted"),
     "toe_overhang_mm": ("mm", "how far the bead's metal (by mass, half a spacing thick) reaches past the melted "
                         "plate on each side: (bead_width_mass - plate_fusion_width) / 2; > 0: the toes lie on "
-                        "plate that never melted (SPH)"),
+                        "plate whose particles never melted (their interface with the melt may be at the melting "
+                        "point; SPH)"),
     **_run_stats("toe_overhang_run_mean_mm", "toe_overhang_run_sd_mm", "mm", "toe overhang"),
     "pool_length_mm": ("mm", "melt pool length"),
     "pool_width_mm": ("mm", "melt pool width"),
