@@ -1996,7 +1996,7 @@ def reduce_bead(x: np.ndarray, types: np.ndarray, melted: np.ndarray, geom: Scen
     out["penetration_depth_mm"] = surface.penetration_depth(x, melted, geom.dx, window, z_surface=0.0)
     out["fusion_width_mm"] = surface.fusion_width(x[deposit], melted[deposit], geom.dx, window, z_surface=0.0)
     out["plate_fusion_width_mm"] = surface.plate_fusion_width(x[deposit], melted[deposit], geom.dx, window)
-    # how far the metal (dx/2 thick) reaches past the melted plate on each side: > 0, toes on unmelted plate
+    # how far the metal (dx/2 thick) reaches past the plate's melted particles on each side
     out["toe_overhang_mm"] = 0.5 * (out["bead_width_mass_mm"] - out["plate_fusion_width_mm"])
     if out.get("bead_width_mm"):
         out["aspect_ratio"] = out["bead_height_mm"] / out["bead_width_mm"]
