@@ -19,4 +19,4 @@ def test_write_json_is_strict_json(tmp_path):
     assert "NaN" not in text and "Infinity" not in text
     strict = json.loads(text, parse_constant=lambda name: pytest.fail(f"non-standard constant {name}"))
     assert strict == {"a": None, "b": None, "c": None, "d": 1.5, "e": [2, None], "f": {"g": None}}
-    assert not list(tmp_path.glob("*.tmp*"))  # no temporary file left beside it
+    assert [f.name for f in tmp_path.iterdir()] == ["metrics.json"]  # no temporary file left beside it

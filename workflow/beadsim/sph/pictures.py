@@ -171,7 +171,7 @@ def section_picture(y: np.ndarray, h_map: np.ndarray, h_mass: np.ndarray, dx: fl
         The measured bead (Table 1), drawn as a circular cap on the bead's axis.
     plate_fused : float, mm, optional
         Width of the plate's surface that melted (``plate_fusion_width_mm``), drawn as a bar on the plate
-        centred on the beam's axis: metal beyond it lies on plate that never melted.
+        centred on the beam's axis: metal beyond it lies on plate whose particles never melted.
     """
     fig, ax = plt.subplots(figsize=(8, 3.2))
     ax.axhline(0.0, color="0.6", lw=0.8)

@@ -558,8 +558,11 @@ def plate_fusion_width(pos, melted_mask, dx, x_window, z_surface=0.0):
     :func:`fusion_width` counts a column fused where its top particle was ever liquid, and every deposited
     particle was, so it reads the deposit's footprint wherever the deposit is wider than the melted plate. This
     leaves the deposit out: it is the width over which the pool melted the plate (the fusion line where it meets
-    the plate's surface). Set beside the bead's width it says whether the bead is fused over its whole base:
-    metal wider than it lies on plate that never melted (its toes are not fused to the plate).
+    the plate's surface). Set beside the bead's width it says how far the metal reaches past the plate's
+    melted particles. That is not by itself a lack of fusion: a plate particle counts as melted only when its
+    centre, half a spacing under the surface, reached the melting point, and under the SPH beads' toes the melt
+    above and the plate particle below sit about as far above and below it, so their interface is near the
+    melting point (README, "The toes lie past the melted plate").
 
     Parameters
     ----------
