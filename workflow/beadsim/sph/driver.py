@@ -890,9 +890,9 @@ class BeadRun:
             solid_types = [t for t in not_liquid if t not in FLUID_TYPES]
             coeffs += model.pair_coeff_commands(list(FLUID_TYPES), solid_types, table_file=self.out / "tension.table")
             if num.plate_cohesion is not None:  # the plate that never melted: its own liquid-solid strength
-                lines = num.plate_cohesion.pair_coeff_commands(list(FLUID_TYPES), [TYPE_SUBSTRATE],
-                                                               table_file=self.out / "tension_plate.table")
-                coeffs += [line for line in lines if str(TYPE_SUBSTRATE) in line.split()[1:3]]
+                coeffs += num.plate_cohesion.pair_coeff_commands(list(FLUID_TYPES), [TYPE_SUBSTRATE],
+                                                                 table_file=self.out / "tension_plate.table",
+                                                                 liquid_pairs=False)
         return styles, coeffs
 
     def _define_physics(self) -> None:

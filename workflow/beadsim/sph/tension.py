@@ -408,7 +408,8 @@ class CohesionModel:
         return path
 
     def pair_coeff_commands(
-        self, liquid_types: list[int], solid_types: list[int], table_file: str | Path | None = None
+        self, liquid_types: list[int], solid_types: list[int], table_file: str | Path | None = None,
+        liquid_pairs: bool = True,
     ) -> list[str]:
         """Return the ``pair_coeff`` lines for the cohesive sub-style.
 
@@ -418,8 +419,10 @@ class CohesionModel:
             LAMMPS atom types of liquid and solid particles.
         table_file : str or Path, optional
             Where to write the table file (backend ``"table"`` only; required there).
+        liquid_pairs : bool
+            Include the liquid-liquid pairs; False for a second model that sets only some solids' pairs.
         """
-        pairs = [(a, b, self.s_ll, "LL") for a in liquid_types for b in liquid_types if a <= b]
+        pairs = [(a, b, self.s_ll, "LL") for a in liquid_types for b in liquid_types if a <= b and liquid_pairs]
         pairs += [(min(a, b), max(a, b), self.s_ls, "LS") for a in liquid_types for b in solid_types]
         if self.backend == "table":
             if table_file is None:
