@@ -252,7 +252,8 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
     mean of every section since the wire's metal arrived) get a second marker, x, with the sections' standard
     deviation as error bar, beside the last sections' bead: for a humping bead the spread is the answer. Open
     triangles: the run means of the width and height from the mass per column (SPH window runs), which a
-    disordered frozen melt does not read low and thin metal at the toes does not escape."""
+    disordered frozen melt does not read low and thin metal at the toes does not escape. Grey stars: the paper's
+    own SPH estimates of the measured beads (Table 1), where the experiments table gives them."""
     fig, axes = plt.subplots(1, 2, figsize=(9, 4.2))
     for ax, q in zip(axes, ("width", "height")):
         meas_all = balance[f"measured_{q}_mm"]
@@ -267,6 +268,10 @@ def parity_plot(errors: pd.DataFrame, balance: pd.DataFrame) -> plt.Figure:
         lim = [0, 1.25 * max(meas_all.max(), top)]
         ax.plot(lim, lim, "k-", lw=1)
         ax.fill_between(lim, [v * 0.95 for v in lim], [v * 1.05 for v in lim], color="0.85", label="+-5 %")
+        paper = balance.dropna(subset=[f"paper_sph_{q}_mm"]) if f"paper_sph_{q}_mm" in balance else balance.iloc[:0]
+        if len(paper):
+            ax.plot(paper[f"measured_{q}_mm"], paper[f"paper_sph_{q}_mm"], "*", color="0.45", ms=9, zorder=1,
+                    label="the paper's SPH estimate (its Table 1)")
         for k, ((model, res), grp) in enumerate(errors.groupby(["model", "resolution_mm"])):
             ok = grp[grp["status"] == "ok"]
             name = model if model == "reduced" else f"{model} dx={res:g} mm"
