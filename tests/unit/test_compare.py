@@ -112,6 +112,9 @@ def test_the_papers_own_sph_estimates_beside_the_measured_beads(experiments):
     assert mb.loc[1, "paper_sph_width_mm"] == pytest.approx(3.45)
     assert mb.loc[1, "paper_sph_width_err_rel"] == pytest.approx(0.15 / 3.3)
     assert list(mb["paper_sph_height_err_rel"].round(3)) == pytest.approx([-0.13, -0.1, -0.143])
+    # as caps, the estimated beads hold what the measured ones hold, not the wire's supply
+    assert list(mb["paper_sph_ratio_cap"].round(2)) == pytest.approx([0.93, 0.68, 0.46])
+    assert mb.loc[1, "paper_sph_ratio_cap"] == pytest.approx(cap_area(3.45, 0.87) / wire_supply_area(1.2, 10, 5))
     fig = parity_plot(pd.DataFrame(columns=["model", "resolution_mm", "status", "mode"]), mb.reset_index())
     for ax, q in zip(fig.axes, ("width", "height")):
         stars = [ln for ln in ax.get_lines() if ln.get_marker() == "*"]
