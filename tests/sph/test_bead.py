@@ -302,6 +302,16 @@ def test_moving_window_conserves_energy_and_feeds_substrate(tmp_path):
     assert 0 < m["plate_fusion_width_mm"] <= m["fusion_width_mm"] + 1e-9
     assert m["toe_overhang_mm"] == pytest.approx(0.5 * (m["bead_width_mass_mm"] - m["plate_fusion_width_mm"]),
                                                  rel=1e-9)
+    # followed by id through the dumps (every 0.1 s here), the metal that froze in the toes (beyond the plate's
+    # melted half-width) last was liquid further from the axis than the core's, near where it froze
+    from beadsim.sph import tracks
+
+    paths = tracks.toe_paths(tmp_path, t_from=0.0, melted_from=0.0, params=params)
+    toe, core = paths[paths.group == "toe"], paths[paths.group == "core"]
+    assert len(toe) > 5 and len(core) > 5
+    assert toe.r_last.median() > core.r_last.median()
+    assert toe.r_last.median() > 0.5 * m["plate_fusion_width_mm"] - params["resolution_mm"]
+    np.testing.assert_allclose(paths.travel, paths.r_last - paths.r_first)
     # resumed at its end (a forced rerun of a finished run resumes from its last checkpoint), the run reports
     # the same bead: the last sections' profiles are in the checkpoint, not only their scalar values
     again = run_case(params, tmp_path, resume=True)
