@@ -6,7 +6,7 @@ each particle is then followed back through all the dumps (every 0.05 s in the m
 was liquid: where it first was liquid, where it froze, how far it travelled sideways, and how that travel was
 spread over its time liquid (README, "The toes lie past the melted plate").
 
-    python -m beadsim.sph.tracks results/<study>/runs/<run_id> [--from 2.0]
+    python -m beadsim.sph.tracks results/<study>/runs/<run_id> [--from 2.0] [--melted-from 1.5]
 """
 
 from __future__ import annotations
@@ -55,7 +55,8 @@ def liquid_histories(snaps: list[tuple[float, dict]]) -> dict[int, np.ndarray]:
 def path_figures(h: np.ndarray, y_axis: float = 0.0) -> dict:
     """Figures of one particle's liquid history ``h`` (rows t, x, y, z; m, s): where it first was liquid and
     where last, its outward travel |y - y_axis| (m), and, where that travel exceeds :data:`MIN_TRAVEL`, the
-    share of it in the largest dump-to-dump step and the share of its time liquid by which half of it was done.
+    share of it in the largest dump-to-dump step (above 1 where it went further out and came back) and the
+    share of its time liquid by which half of it was done.
     """
     r = np.abs(h[:, 2] - y_axis)
     out = {"t_first": h[0, 0], "r_first": r[0], "z_first": h[0, 3], "t_last": h[-1, 0], "r_last": r[-1],
