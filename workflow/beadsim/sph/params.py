@@ -147,8 +147,9 @@ SPH_PARAMETERS: list[Param] = [
           short="lms", models=_SPH, long_name="loose-melt smoothing radius / dx"),
     Param("stop_at_steady_state", "boolean", False, "", "stop before sim_time_s once the melt count and pool "
           "length are steady within steady_tolerance over two 0.2 s windows (in the window domain also the last "
-          "three bead sections' mass balance within it of 1, and bead_sections steady sections to average); a humping bead "
-          "can pass in a quiet spell (mode 1 with plate_wetting_ratio 0.25: at 3.15 s, a hump from 3.6 s)",
+          "three bead sections' mass balance within it of 1, and bead_sections steady sections to average); a "
+          "humping bead can pass in a quiet spell (mode 1 with plate_wetting_ratio 0.25: at 3.15 s, a hump from "
+          "3.6 s)",
           short="ss", models=_SPH),
     Param("steady_tolerance", "number", 0.05, "1", "relative change of the steady-state criteria allowed "
           "between two successive averaging windows", exclusive_minimum=0, maximum=1, short="sstol",
