@@ -19,27 +19,23 @@ import numpy as np
 import pandas as pd
 
 from beadsim.sph import surface
-from beadsim.sph.pictures import read_dump
+from beadsim.sph.pictures import dumps_by_step, read_dump
 from beadsim.sph.scene import FLUID_TYPES, TYPE_LIQUID, TYPE_RESOLIDIFIED, TYPE_WIRE
 
 #: Sideways travel (m) below which a particle's travel is not split into steps (dump-to-dump jitter)
 MIN_TRAVEL = 0.2e-3
 
 
-def snapshots(run_dir: str | Path, t_min: float = 0.0) -> list[tuple[float, dict]]:
-    """The run's dumps at or after ``t_min`` (s), in time order, as (t, :func:`read_dump` columns); the time
-    of each from its step through the run's ``timeseries.nc``."""
+def snapshots(run_dir: str | Path) -> list[tuple[float, dict]]:
+    """The run's dumps in time order, as (t, :func:`read_dump` columns); the time of each from its step
+    through the run's ``timeseries.nc``."""
     import xarray as xr
 
     run_dir = Path(run_dir)
     with xr.open_dataset(run_dir / "timeseries.nc") as ds:
         steps, ts = ds["step"].values, ds["t"].values
-    out = []
-    for f in sorted((run_dir / "dumps").glob("dump.*.lammpstrj"), key=lambda p: int(p.name.split(".")[1])):
-        t = float(np.interp(int(f.name.split(".")[1]), steps, ts))
-        if t >= t_min:
-            out.append((t, read_dump(f)))
-    return out
+    dumps = [read_dump(f) for f in dumps_by_step(run_dir / "dumps")]
+    return [(float(np.interp(d["timestep"], steps, ts)), d) for d in dumps]
 
 
 def liquid_histories(snaps: list[tuple[float, dict]]) -> dict[int, np.ndarray]:
