@@ -5,6 +5,7 @@ quantities must agree exactly and the rest within a few percent (measured: evapo
 2.5 %, pool volume 3.6-10 % apart at 0.25 s).
 """
 
+import json
 import re
 import time
 from pathlib import Path
@@ -132,3 +133,19 @@ def test_height_function_on_two_ranks(tmp_path):
     series = [xr.load_dataset(tmp_path / name / "timeseries.nc") for name in ("one", "two")]
     assert abs(int(series[1]["n_liquid"][-1]) - int(series[0]["n_liquid"][-1])) <= 2
     assert series[1]["E_internal"][-1].item() == pytest.approx(series[0]["E_internal"][-1].item(), rel=5e-3)
+
+
+@pytest.mark.mpi
+def test_contact_freeze_on_two_ranks(tmp_path):
+    """contact_freeze: each rank holds its own melt that touches cold plate, through the plate's particles it
+    owns and its ghosts of another rank's. Checked at every chunk against the rule applied to the gathered
+    particles of both ranks (tests/sph/mpi_pins.py), including melt held through a contact on the other rank
+    alone. A ghost's energy is that of the last communication, a step before the chunk's end, so a pair within
+    a step's heating of the melting point may read the other way (none seen)."""
+    params = small_case(sim_time_s=0.25, contact_freeze=True)
+    entry = (str(Path(__file__).with_name("mpi_pins.py")),)
+    two = run_mpi(params, tmp_path, tasks=2, timeout=TIMEOUT, entry=entry)
+    assert abs(two["energy_balance_error"]) < 1e-3
+    counts = json.loads((tmp_path / "pin_check.json").read_text())
+    assert counts["held"] > 100 and counts["across"] > 0
+    assert counts["mismatched"] <= 0.01 * counts["held"]

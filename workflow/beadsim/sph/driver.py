@@ -767,6 +767,8 @@ class BeadRun:
         self.loose_ceiling = bool(params["loose_melt_ceiling"]) and self.num.cohesion is not None
         self.height_function = self.num.height_function
         self.wire_key: tuple = ()  # the unmelted wire's ids and feed slice at the last connectivity search
+        self.contact_freeze = bool(params["contact_freeze"])
+        self.n_pinned = 0  # melt particles held by contact_freeze after the last chunk (all ranks)
 
     # ---- setup
     def open(self, resume: bool) -> None:
@@ -918,9 +920,13 @@ class BeadRun:
         cmd("compute T all sph/t/atom")
         # falling (detached) wire moves with the fluid whatever its temperature
         if self.num.cohesion is None:
-            cmd(f"variable frozen atom c_T<{self.mat.T_melt:.9g}&&type!={TYPE_FALLING}")
+            frozen = f"c_T<{self.mat.T_melt:.9g}&&type!={TYPE_FALLING}"
         else:  # cohesion acts by type: melt and freeze at chunk ends, when the types switch
-            cmd(f"variable frozen atom type!={TYPE_LIQUID}&&type!={TYPE_FALLING}")
+            frozen = f"type!={TYPE_LIQUID}&&type!={TYPE_FALLING}"
+        if self.contact_freeze:  # melt held where it touches cold plate, set at chunk ends (_contact_pins)
+            cmd("fix pin all property/atom d_pin ghost no")
+            frozen = f"({frozen})||d_pin>0"
+        cmd(f"variable frozen atom {frozen}")
         cmd("group frozen dynamic all var frozen every 1")
         if self.height_function:  # the surface force of the chunk and where each particle started it
             cmd("fix hfstore all property/atom d_hfx d_hfy d_hfz d_hx0 d_hy0 d_hz0 ghost no")
@@ -928,7 +934,7 @@ class BeadRun:
                 cmd(f"variable hf{c} atom d_hf{c}")
         if p["resolidified_density"] == "freeze":  # after read_restart, the same ID restores the values
             cmd("fix rhofreeze all property/atom d_rhofreeze ghost no")
-        if p["resolidified_density"] == "freeze" or self.height_function:
+        if p["resolidified_density"] == "freeze" or self.height_function or self.contact_freeze:
             if self.resumed:
                 # LAMMPS keeps the restart file's per-atom fix data until a run initialises, and refuses
                 # create_atoms until then: the window's first new substrate layer (or a wire slice) would stop
@@ -1204,6 +1210,11 @@ class BeadRun:
             rho_freeze[froze] = self._rho()[froze]
         types[:] = new_types
         frozen = ~liquid & (new_types != TYPE_FALLING)
+        if self.contact_freeze:
+            pinned = self._contact_pins(temp, liquid & (new_types == TYPE_LIQUID))
+            self.lmp.numpy.extract_atom("d_pin")[: len(pinned)] = pinned
+            self.n_pinned = allreduce(self.lmp, int(pinned.sum()))
+            frozen |= pinned
         target = np.where(types[frozen, None] == TYPE_WIRE, self._wire_velocity(), self.geom.substrate_velocity)
         # kinetic energy removed by freezing a particle in place becomes heat of that particle
         ke_old = 0.5 * self.num.mass * np.einsum("ij,ij->i", v[frozen], v[frozen])
@@ -1219,6 +1230,46 @@ class BeadRun:
                 kept = ~liquid & (rho_freeze > 0)
                 rho[kept] = rho_freeze[kept]
         return temp, changed
+
+    def _contact_pins(self, temp: np.ndarray, liquid: np.ndarray) -> np.ndarray:
+        """contact_freeze: which of this rank's melt particles touch plate that never melted (a particle of type
+        substrate within 1.25 dx, own or ghost) at a contact temperature below the melting point.
+
+        The contact temperature of a pair is the mean of the two: the interface temperature of two bodies of
+        equal effusivity put in contact, and where a liquid-solid pair's conduction (the solid's conductivity on
+        both sides, equal masses) places it. Ghost types are those of the last LAMMPS communication: a ghost
+        that melted since still reads substrate, but its temperature, at or above the melting point, cannot pin.
+        """
+        pinned = np.zeros(len(temp), dtype=bool)
+        if not liquid.any():
+            return pinned
+        nlocal = len(temp)
+        nall = nlocal + self.lmp.extract_setting("nghost")
+        x = self.lmp.numpy.extract_atom("x", nelem=nall, dim=3)
+        plate = self.lmp.numpy.extract_atom("type", nelem=nall) == TYPE_SUBSTRATE
+        plate[:nlocal] = self._types() == TYPE_SUBSTRATE
+        if not plate.any():
+            return pinned
+        reach = 1.25 * self.num.dx
+        near = np.flatnonzero(plate)
+        lo, hi = x[:nlocal][liquid].min(axis=0) - reach, x[:nlocal][liquid].max(axis=0) + reach
+        near = near[within_box(x[near], lo, hi)]
+        if len(near) == 0:
+            return pinned
+        e_all = self.lmp.numpy.extract_atom("esph", nelem=nall)
+        if self.thermal.latent:
+            t_near = self.thermal.temperature(e_all[near])
+        else:
+            t_near = e_all[near] / self.lmp.numpy.extract_atom("cv", nelem=nall)[near]
+        t_near[near < nlocal] = temp[near[near < nlocal]]
+        idx = np.flatnonzero(liquid)
+        pairs = cKDTree(x[idx]).sparse_distance_matrix(cKDTree(x[near]), reach, output_type="coo_matrix")
+        if pairs.nnz == 0:
+            return pinned
+        coldest = np.full(len(idx), np.inf)
+        np.minimum.at(coldest, pairs.row, t_near[pairs.col])
+        pinned[idx] = 0.5 * (temp[idx] + coldest) < self.mat.T_melt
+        return pinned
 
     def _release_detached(self, ids: np.ndarray, wire: np.ndarray) -> None:
         """Mark the unmelted wire particles cut off from the feed end as released (on every rank: the
@@ -1432,6 +1483,7 @@ class BeadRun:
              "T_max": allreduce(lmp, float(temp.max()), "max"),
              "n_liquid": allreduce(lmp, int(liquid.sum())),
              "n_falling": allreduce(lmp, int((types == TYPE_FALLING).sum())),
+             "n_pinned": self.n_pinned,
              "n_atoms": int(lmp.get_natoms()),
              "rho_min": allreduce(lmp, float(rho[fluid].min()) if fluid.any() else 1.0, "min"),
              "rho_max": allreduce(lmp, float(rho[fluid].max()) if fluid.any() else 1.0, "max"),

@@ -56,6 +56,14 @@ SPH_PARAMETERS: list[Param] = [
           "takes place'; a ratio below that of wetting_angle_deg wets the melted metal better than the cold "
           "plate (ridges: 0.5 / 0.6 / 0.8 give 85 / 75 / 52 degree, tension.py)", minimum=0, maximum=1.3,
           short="pwr", models=_SPH, long_name="plate wetting ratio"),
+    Param("contact_freeze", "boolean", False, "", "hold a melt particle still (moving with the plate) while it "
+          "touches plate that never melted (within 1.25 dx) and the contact temperature of the pair, the mean of "
+          "the two temperatures (the interface temperature of two like bodies put in contact), is below the "
+          "melting point: the melt freezes where it meets cold plate, so a contact line running out over the "
+          "plate stops (arrest by solidification at the contact line); it flows again once the plate beneath "
+          "warms. A stand-in for the solid skin dx cannot resolve; the particle keeps its energy and counts as "
+          "melt. A probe of what sets the SPH beads' width, beside plate_wetting_ratio; off in the paper",
+          short="cfz", models=_SPH, long_name="contact freeze"),
     Param("latent_heat", "boolean", False, "", "latent heat of fusion as an effective heat capacity over "
           "mushy_range_K above T_melt; off to match the paper", short="lh", models=_SPH),
     Param("mushy_range_K", "number", 50.0, "K", "temperature range over which the latent heat is released "
