@@ -1239,6 +1239,8 @@ class BeadRun:
         equal effusivity put in contact, and where a liquid-solid pair's conduction (the solid's conductivity on
         both sides, equal masses) places it. Ghost types are those of the last LAMMPS communication: a ghost
         that melted since still reads substrate, but its temperature, at or above the melting point, cannot pin.
+        Called by :meth:`_phase_update` once it has written this chunk's types and before it moves any energy,
+        so the own particles' types and temperatures read here are those it decided with.
         """
         pinned = np.zeros(len(temp), dtype=bool)
         if not liquid.any():
@@ -1247,7 +1249,6 @@ class BeadRun:
         nall = nlocal + self.lmp.extract_setting("nghost")
         x = self.lmp.numpy.extract_atom("x", nelem=nall, dim=3)
         plate = self.lmp.numpy.extract_atom("type", nelem=nall) == TYPE_SUBSTRATE
-        plate[:nlocal] = self._types() == TYPE_SUBSTRATE
         if not plate.any():
             return pinned
         reach = 1.25 * self.num.dx
@@ -1261,7 +1262,6 @@ class BeadRun:
             t_near = self.thermal.temperature(e_all[near])
         else:
             t_near = e_all[near] / self.lmp.numpy.extract_atom("cv", nelem=nall)[near]
-        t_near[near < nlocal] = temp[near[near < nlocal]]
         idx = np.flatnonzero(liquid)
         pairs = cKDTree(x[idx]).sparse_distance_matrix(cKDTree(x[near]), reach, output_type="coo_matrix")
         if pairs.nnz == 0:
