@@ -37,6 +37,11 @@ def test_contact_freeze_holds_the_melt_that_touches_cold_plate(tmp_path):
         assert 0 < expect.sum() < len(liquid)  # some melt touches cold plate, not all of it
         np.testing.assert_array_equal(pin, expect)
         assert run.n_pinned == expect.sum() and run.series[-1]["n_pinned"] == expect.sum()
+        # the run's held share: the second half's chunks, each n_pinned / n_liquid
+        half = [s["n_pinned"] / s["n_liquid"] for s in run.series if s["t"] >= run.state.t / 2 - 1e-12
+                and s["n_liquid"] > 0]
+        assert len(half) >= 2 and 0 < m["held_melt_share"] < 1
+        assert m["held_melt_share"] == pytest.approx(np.mean(half), rel=1e-12)
         np.testing.assert_allclose(v[pin], np.broadcast_to(run.geom.substrate_velocity, (pin.sum(), 3)))
         # one more chunk: the held melt moves with the plate, exactly; the free melt does not
         run.deck(f"run {run.chunk} pre yes post no")

@@ -106,6 +106,8 @@ METRICS: dict[str, tuple[str, str]] = {
                               "half of the run)"),
     "beam_share_wire_melt": ("1", "share of the absorbed beam energy that landed on melt from the wire, on the "
                              "wire's tip or in the pool (SPH; second half of the run)"),
+    "held_melt_share": ("1", "share of the melt held still where it touches cold plate, mean over the second "
+                        "half of the run (SPH, contact_freeze; NaN without it)"),
     "wire_released_particles": ("1", "unmelted wire particles cut off from the fed wire (fell free)"),
     "wire_landed_particles": ("1", "released wire particles that landed on solid before melting"),
 }

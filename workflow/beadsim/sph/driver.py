@@ -1865,6 +1865,16 @@ class BeadRun:
         return {"beam_share_solid_wire": (half[-1]["E_beam_solid_wire"] - half[0]["E_beam_solid_wire"]) / d_beam,
                 "beam_share_wire_melt": (half[-1]["E_beam_wire_melt"] - half[0]["E_beam_wire_melt"]) / d_beam}
 
+    def _held_share(self) -> dict:
+        """contact_freeze: the share of the melt held (touching cold plate) over the run's second half, the mean of
+        n_pinned / n_liquid over the chunks with melt (NaN without contact_freeze or melt). A held particle is a
+        whole particle, so this is the frozen skin's share at the spacing; it should fall as dx does."""
+        if not self.p["contact_freeze"]:
+            return {"held_melt_share": np.nan}
+        shares = [m["n_pinned"] / m["n_liquid"] for m in self.series
+                  if m["t"] >= self.state.t / 2 - 1e-12 and m.get("n_liquid", 0) > 0]
+        return {"held_melt_share": float(np.mean(shares)) if shares else np.nan}
+
     def _meltback(self) -> dict:
         """Wire melt-back over the second half of the run (samples after the feed started): the mean distance
         (mm) the solid wire's tip sits behind the nominal tip plane along the axis, and the share of samples in
@@ -1910,6 +1920,7 @@ class BeadRun:
         out["python_time_share_bead_checks"] = self.bead_time / wall if wall > 0 else np.nan
         out.update(self._meltback())
         out.update(self._beam_shares())
+        out.update(self._held_share())
         out["wire_melt_power_W"] = (self.mat.rho * area_w * 1e-6 * p["wire_feed_mm_s"] * 1e-3
                                     * (self.mat.cp * (self.mat.T_melt - self.T0) + self.mat.latent_heat))
         packing = [m["liquid_packing"] for m in self.series
