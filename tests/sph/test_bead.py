@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from beadsim import runner
 from beadsim.errors import SimulationFailed
 from beadsim.parameters import defaults
 from beadsim.sph.driver import run_case
@@ -348,22 +349,43 @@ def test_resumed_window_run_continues_the_interrupted_one(tmp_path):
     ``resolidified_density: freeze`` (the combination the resume once stopped on: LAMMPS refused the window's
     first new substrate layer until a run had claimed the restart's per-atom data). Resumed runs are not
     bitwise equal (the restart reorders the particles, and the melt amplifies round-off: pool length 5.1 vs
-    4.5 mm measured), so the checks are the deterministic quantities and the energy ledger."""
+    4.5 mm measured), so the checks are the deterministic quantities and the energy ledger.
+
+    ``continue_from`` (runner) does the same from a finished run in another folder: the source is left as it
+    was, the continuation holds the whole history and names its source in result.json."""
     kw = dict(domain="window", window_thermal_lengths=5.0, resolidified_density="freeze")
     straight = run_case(small_case(sim_time_s=0.3, **kw), tmp_path / "straight")
     split = tmp_path / "split"
-    first = run_case(small_case(sim_time_s=0.2, **kw), split)  # a new layer is due at 0.2 s (dx / V_s = 0.04 s)
+    # a new layer is due at 0.2 s (dx / V_s = 0.04 s)
+    first = runner.run_case(small_case(sim_time_s=0.2, **kw), split, run_id="split")
+    source_record = (split / "result.json").read_text()
+    cont = tmp_path / "cont"
+    record = runner.run_case(small_case(sim_time_s=0.3, continue_from="split", **kw), cont, run_id="cont")
+    assert record["status"] == "ok", record["reason"]
+    assert (split / "result.json").read_text() == source_record  # the source is not touched
+    assert record["continued_from"]["run_id"] == "split"
+    assert record["continued_from"]["t_s"] == pytest.approx(0.2, abs=0.002)
+    assert record["continued_from"]["provenance"] == first["provenance"]
     resumed = run_case(small_case(sim_time_s=0.3, **kw), split, resume=True)
-    at = re.search(r"# python: resume from checkpoint at t = (\S+) s", (split / "deck.in").read_text())
-    assert at and float(at[1]) == pytest.approx(0.2, abs=0.002)
-    for key in ("n_particles", "n_steps", "simulated_time_s", "energy_in_J"):
-        assert resumed[key] == straight[key], key
-    assert abs(resumed["energy_balance_error"]) < ENERGY_BALANCE_TOL
-    assert resumed["boundary_heat_loss_J"] == pytest.approx(straight["boundary_heat_loss_J"], rel=1e-3)
-    assert resumed["evaporated_energy_J"] == pytest.approx(straight["evaporated_energy_J"], rel=0.03)
-    ts = xr.open_dataset(split / "timeseries.nc")
-    assert float(ts.time[0]) < 0.2 < float(ts.time[-1]) == pytest.approx(0.3, rel=1e-3)  # one series, both parts
-    assert resumed["wall_time_s"] > first["wall_time_s"]  # counts on from the checkpoint
+    for folder, out in ((split, resumed), (cont, record["metrics"])):
+        at = re.search(r"# python: resume from checkpoint at t = (\S+) s", (folder / "deck.in").read_text())
+        assert at and float(at[1]) == pytest.approx(0.2, abs=0.002)
+        for key in ("n_particles", "n_steps", "simulated_time_s", "energy_in_J"):
+            assert out[key] == straight[key], (folder.name, key)
+        assert abs(out["energy_balance_error"]) < ENERGY_BALANCE_TOL
+        assert out["boundary_heat_loss_J"] == pytest.approx(straight["boundary_heat_loss_J"], rel=1e-3)
+        assert out["evaporated_energy_J"] == pytest.approx(straight["evaporated_energy_J"], rel=0.03)
+        ts = xr.open_dataset(folder / "timeseries.nc")
+        assert float(ts.time[0]) < 0.2 < float(ts.time[-1]) == pytest.approx(0.3, rel=1e-3)  # one series, both parts
+        assert out["wall_time_s"] > first["metrics"]["wall_time_s"]  # counts on from the checkpoint
+    assert sorted(p.name for p in (cont / "dumps").iterdir()) == sorted(p.name for p in (split / "dumps").iterdir())
+
+    # a source that failed is not continued: the continuation fails with the reason, the sweep goes on
+    failed = tmp_path / "failed"
+    failed.mkdir()
+    (failed / "result.json").write_text(json.dumps({"status": "failed", "reason": "density 0.4 rho0 at t=0.1 s"}))
+    bad = runner.run_case(small_case(sim_time_s=0.3, continue_from="failed", **kw), tmp_path / "bad", run_id="bad")
+    assert bad["status"] == "failed" and "the source run failed (density 0.4 rho0" in bad["reason"]
 
 
 @pytest.mark.parametrize("n_sections", [3, 5])

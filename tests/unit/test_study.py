@@ -62,3 +62,33 @@ def test_config_errors_name_the_key(cfg, message, experiments):
     with pytest.raises(ConfigError, match=None) as err:
         design({"study": "t", **cfg}, experiments)
     assert message in str(err.value)
+
+
+SPH_WINDOW = {"model": "sph", "domain": "window", "sim_time_s": 1.0}
+
+
+def test_continue_from_names_a_shorter_run_of_the_same_scene(experiments):
+    """A continuation may run longer and change the steady-state stop; a source that is not there, is itself,
+    is another scene, is not shorter, or cannot be continued (reduced model, a block sized from sim_time_s)
+    stops the study with the run, the key and what is allowed named."""
+    ok = {"study": "t", "base": SPH_WINDOW, "sweep": [{"cases": [
+        {"name": "a"}, {"name": "b", "sim_time_s": 2.0, "stop_at_steady_state": True, "continue_from": "a"},
+        {"name": "c", "sim_time_s": 3.0, "continue_from": "b"}]}]}
+    df = design(ok, experiments)
+    assert df["continue_from"].to_dict() == {"a": "", "b": "a", "c": "b"}
+
+    def fails(cases, base=SPH_WINDOW):
+        with pytest.raises(ConfigError) as err:
+            design({"study": "t", "base": base, "sweep": [{"cases": cases}]}, experiments)
+        return str(err.value)
+
+    text = fails([{"name": "a"}, {"name": "b", "sim_time_s": 2.0, "continue_from": "x"}])
+    assert "run 'b': continue_from: 'x' is not another run of this study; allowed: ['a']" in text
+    assert "not another run" in fails([{"name": "a", "continue_from": "a"}])
+    text = fails([{"name": "a"}, {"name": "b", "sim_time_s": 2.0, "beam_power_W": 900, "continue_from": "a"}])
+    assert "'a' is another scene (beam_power_W 1000.0 there, 900" in text and "change only sim_time_s" in text
+    assert "nothing to continue" in fails([{"name": "a"}, {"name": "b", "continue_from": "a"}])
+    assert "needs domain window or plate" in fails([{"name": "a"}, {"name": "b", "sim_time_s": 2.0,
+                                                                    "continue_from": "a"}], {**SPH_WINDOW, "domain": "auto"})
+    assert "only SPH runs" in fails([{"name": "a"}, {"name": "b", "sim_time_s": 2.0, "continue_from": "a"}],
+                                    {**SPH_WINDOW, "model": "reduced"})

@@ -102,6 +102,27 @@ def test_bad_config_stops_with_the_key_named(tmp_path):
     assert "wire_angel_deg" in text and "Additional properties" in text, text
 
 
+def test_continued_run_waits_for_its_source(tmp_path):
+    """continue_from puts the source run before the continued one in the DAG; a source not in the study stops
+    the workflow before anything runs, naming the run, the key and the runs allowed."""
+    cfg = yaml.safe_load((ROOT / "tests" / "configs" / "tiny_sph.yaml").read_text())
+    cfg["base"]["domain"] = "window"
+    cfg["sweep"] = [{"cases": [{"name": "a"}, {"name": "b", "sim_time_s": 0.2, "continue_from": "a"}]}]
+    config = tmp_path / "cont.yaml"
+    config.write_text(yaml.safe_dump(cfg))
+    proc = snakemake(tmp_path, config, "--dag")
+    assert proc.returncode == 0, proc.stderr[-4000:]
+    nodes = dict(re.findall(r'(\d+)\[label = "simulate_bead\\nrun_id: (\w+)"', proc.stdout))
+    by_run = {run: node for node, run in nodes.items()}
+    assert sorted(by_run) == ["a", "b"], proc.stdout
+    assert f"{by_run['a']} -> {by_run['b']}" in proc.stdout and f"{by_run['b']} -> {by_run['a']}" not in proc.stdout
+    cfg["sweep"][0]["cases"][1]["continue_from"] = "c"
+    config.write_text(yaml.safe_dump(cfg))
+    proc = snakemake(tmp_path, config, "--dry-run")
+    assert proc.returncode != 0
+    assert "run 'b': continue_from: 'c' is not another run of this study; allowed: ['a']" in proc.stdout + proc.stderr
+
+
 def test_lint_is_clean():
     proc = subprocess.run([sys.executable, "-m", "snakemake", "--snakefile", str(ROOT / "Snakefile"), "--lint"],
                           capture_output=True, text=True, cwd=ROOT, timeout=300)

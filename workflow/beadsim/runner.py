@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import json
 import logging
+import os
+import shutil
 import time
 import traceback
 from pathlib import Path
@@ -34,6 +36,9 @@ def run_model(params: dict, outdir: Path, materials_file=None, tasks: int = 1, m
     material = get_material(params["material"], materials_file)
     resume = params["model"] == "sph" and _can_resume(params, outdir)
     write_json(outdir / "params.json", {"run_id": run_id, **params})
+    if params["model"] == "sph" and params.get("continue_from") and not resume:
+        seed_continuation(params["continue_from"], outdir)
+        resume = True
     if params["model"] == "reduced":
         from beadsim.reduced import run_reduced
 
@@ -69,6 +74,55 @@ def _can_resume(params: dict, outdir: Path) -> bool:
     return not finished
 
 
+#: files of a run folder that a continuation does not take from its source (its own, or the plots' rule's)
+_NOT_CONTINUED = ("params.json", "result.json", "continued_from.json")
+
+
+def seed_continuation(source_id: str, outdir: Path) -> None:
+    """Start a ``continue_from`` run from the finished run ``source_id`` beside ``outdir``: take its checkpoint
+    (marked unfinished, so that it is resumed), dumps, deck, logs and time series, and write
+    ``continued_from.json`` (the source, where it ended, and the provenance of the code that ran it).
+
+    Raises
+    ------
+    SimulationFailed
+        The source has no result, failed, or left no checkpoint.
+    """
+    src = outdir.parent / source_id
+    result = src / "result.json"
+    if not result.exists():
+        raise SimulationFailed(f"continue_from {source_id!r}: {result} does not exist (run the source first)")
+    record = json.loads(result.read_text())
+    if record["status"] != "ok":
+        raise SimulationFailed(f"continue_from {source_id!r}: the source run failed ({record['reason']}): "
+                               "nothing sound to continue")
+    state_file = src / "restart" / "state.npz"
+    if not state_file.exists():
+        raise SimulationFailed(f"continue_from {source_id!r}: the source left no checkpoint ({state_file})")
+    for sub in ("dumps", "restart"):  # what an earlier attempt left here is not this run's history
+        shutil.rmtree(outdir / sub, ignore_errors=True)
+    for item in sorted(src.iterdir()):
+        if item.name in _NOT_CONTINUED or item.suffix == ".png":
+            continue
+        if item.is_dir():
+            shutil.copytree(item, outdir / item.name)
+        else:
+            shutil.copy2(item, outdir / item.name)
+    with np.load(outdir / "restart" / "state.npz") as data:
+        arrays = {k: data[k] for k in data.files}
+    state = json.loads(str(arrays["state"]))
+    write_json(outdir / "continued_from.json", {
+        "run_id": source_id, "t_s": state["t"], "step": state["step"], "source_elapsed_s": record["elapsed_s"],
+        "provenance": record["provenance"]})
+    # last: until the checkpoint reads unfinished, an interrupted seeding is seeded again, not resumed
+    state["finished"] = False
+    arrays["state"] = json.dumps(state)
+    tmp = outdir / "restart" / "state.tmp.npz"
+    np.savez(tmp, **arrays)
+    os.replace(tmp, outdir / "restart" / "state.npz")
+    log.info("continuing %s from t = %.4g s (step %d)", source_id, state["t"], state["step"])
+
+
 def run_case(params: dict, outdir: str | Path, run_id: str = "", materials_file=None, tasks: int = 1,
              mpi: str = "mpirun") -> dict:
     """Run one case and write ``params.json`` and ``result.json`` (atomically) into ``outdir``.
@@ -100,6 +154,11 @@ def run_case(params: dict, outdir: str | Path, run_id: str = "", materials_file=
         "elapsed_s": time.perf_counter() - t0,
         "provenance": provenance(with_lammps=params["model"] == "sph"),
     }
+    seeded = outdir / "continued_from.json"
+    if params.get("continue_from") and seeded.exists():
+        source = json.loads(seeded.read_text())
+        if source["run_id"] == params["continue_from"]:
+            record["continued_from"] = source
     write_json(outdir / "result.json", record)
     log.info("run %s: %s %s (%.2f s)", run_id, status, reason, record["elapsed_s"])
     return record

@@ -197,7 +197,41 @@ def design(config: dict, experiments: pd.DataFrame | None = None) -> pd.DataFram
     dup = df.index[df.index.duplicated()].unique().tolist()
     if dup:
         raise ConfigError(f"sweep: these run ids appear more than once: {dup}; give cases distinct names or values")
+    _check_continuations(df)
     return df
+
+
+#: what a continued run may change against the run it continues (``continue_from``)
+CONTINUE_MAY_CHANGE = ("sim_time_s", "stop_at_steady_state", "continue_from")
+
+
+def _check_continuations(df: pd.DataFrame) -> None:
+    """``continue_from`` names another SPH run of the study, of the same scene and a shorter run."""
+    if "continue_from" not in df.columns:
+        return
+    ids = df.index.tolist()
+    for run_id, source in df["continue_from"].items():
+        if not source:
+            continue
+        where = f"sweep: run {run_id!r}: continue_from"
+        row = df.loc[run_id]
+        if row["model"] != "sph":
+            raise ConfigError(f"{where}: only SPH runs continue a checkpoint; model is {row['model']!r}")
+        if source not in ids or source == run_id:
+            raise ConfigError(f"{where}: {source!r} is not another run of this study; allowed: "
+                              f"{[i for i in ids if i != run_id and df.loc[i, 'model'] == 'sph']}")
+        if row["domain"] not in ("window", "plate"):
+            raise ConfigError(f"{where}: needs domain window or plate (domain {row['domain']!r} sizes the block "
+                              "from sim_time_s, so the checkpoint's block is not this run's)")
+        src, row = case_params(df, source), case_params(df, run_id)
+        fixed = [k for k in row if k not in CONTINUE_MAY_CHANGE]
+        differ = [f"{k} {src[k]!r} there, {row[k]!r} here" for k in fixed if str(src[k]) != str(row[k])]
+        if differ:
+            raise ConfigError(f"{where}: {source!r} is another scene ({'; '.join(differ)}); a continued run may "
+                              f"change only {' and '.join(CONTINUE_MAY_CHANGE[:2])}")
+        if not src["sim_time_s"] < row["sim_time_s"]:  # (so the runs cannot continue each other in a cycle)
+            raise ConfigError(f"{where}: {source!r} runs to sim_time_s {src['sim_time_s']} s, not less than this "
+                              f"run's {row['sim_time_s']} s: nothing to continue")
 
 
 def case_params(df: pd.DataFrame, run_id: str) -> dict:

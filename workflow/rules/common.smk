@@ -34,6 +34,12 @@ def get_case(wildcards):
     return case_params(DESIGN, wildcards.run_id)
 
 
+def get_continued(wildcards):
+    """The result of the run a continue_from run continues (its checkpoint is this run's start)."""
+    source = get_case(wildcards).get("continue_from", "")
+    return [f"{OUT}/runs/{source}/result.json"] if source else []
+
+
 def get_tasks(wildcards):
     """MPI ranks of one run: execution.sph_tasks for SPH runs, 1 for the reduced model."""
     return int(EXECUTION["sph_tasks"]) if get_case(wildcards)["model"] == "sph" else 1

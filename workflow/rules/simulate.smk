@@ -1,4 +1,6 @@
 rule simulate_bead:
+    input:
+        get_continued,
     output:
         f"{OUT}/runs/{{run_id}}/result.json",
     params:

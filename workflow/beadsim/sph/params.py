@@ -168,6 +168,13 @@ SPH_PARAMETERS: list[Param] = [
           maximum=60, short="dump", models=_SPH, long_name="dump interval"),
     Param("restart_interval_s", "number", 0.25, "s", "process time between restart checkpoints",
           exclusive_minimum=0, maximum=60, short="rst", models=_SPH, long_name="restart interval"),
+    Param("continue_from", "string", "", "", "run id of a case in the same study whose last checkpoint this run "
+          "continues (to its own sim_time_s) instead of starting at t = 0: a study run on to a longer time "
+          "without repeating what it has. The source's parameters must be this run's except sim_time_s (smaller "
+          "there) and stop_at_steady_state, with domain window or plate (auto sizes the block from sim_time_s); "
+          "the workflow runs the source first. The run folder gets the source's dumps, deck and series, so it "
+          "holds the whole history, and result.json names the source under continued_from; \"\" starts at "
+          "t = 0", short="cont", models=_SPH, long_name="continued from"),
     Param("density_tolerance", "number", 0.2, "1", "watchdog: fail when the liquid density leaves "
           "[1 - tol, 1 + tol] rho0", exclusive_minimum=0, maximum=1, short="rtol", models=_SPH),
     Param("speed_limit_m_s", "number", 0.0, "m s-1", "watchdog: fail above this particle speed; 0 = half the "
