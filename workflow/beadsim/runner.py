@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import logging
-import os
 import shutil
 import time
 import traceback
@@ -19,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from beadsim.errors import SimulationFailed
-from beadsim.io import write_json
+from beadsim.io import atomic_path, write_json
 from beadsim.materials import get_material
 from beadsim.provenance import provenance
 
@@ -74,7 +73,7 @@ def _can_resume(params: dict, outdir: Path) -> bool:
     return not finished
 
 
-#: files of a run folder that a continuation does not take from its source (its own, or the plots' rule's)
+#: files of a run folder that a continuation does not take from its source (besides the pictures, *.png)
 _NOT_CONTINUED = ("params.json", "result.json", "continued_from.json")
 
 
@@ -117,9 +116,8 @@ def seed_continuation(source_id: str, outdir: Path) -> None:
     # last: until the checkpoint reads unfinished, an interrupted seeding is seeded again, not resumed
     state["finished"] = False
     arrays["state"] = json.dumps(state)
-    tmp = outdir / "restart" / "state.tmp.npz"
-    np.savez(tmp, **arrays)
-    os.replace(tmp, outdir / "restart" / "state.npz")
+    with atomic_path(outdir / "restart" / "state.npz") as tmp:
+        np.savez(tmp, **arrays)
     log.info("continuing %s from t = %.4g s (step %d)", source_id, state["t"], state["step"])
 
 

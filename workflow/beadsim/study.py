@@ -214,7 +214,7 @@ def _check_continuations(df: pd.DataFrame) -> None:
         if not source:
             continue
         where = f"sweep: run {run_id!r}: continue_from"
-        row = df.loc[run_id]
+        row = case_params(df, run_id)
         if row["model"] != "sph":
             raise ConfigError(f"{where}: only SPH runs continue a checkpoint; model is {row['model']!r}")
         if source not in ids or source == run_id:
@@ -223,7 +223,7 @@ def _check_continuations(df: pd.DataFrame) -> None:
         if row["domain"] not in ("window", "plate"):
             raise ConfigError(f"{where}: needs domain window or plate (domain {row['domain']!r} sizes the block "
                               "from sim_time_s, so the checkpoint's block is not this run's)")
-        src, row = case_params(df, source), case_params(df, run_id)
+        src = case_params(df, source)
         fixed = [k for k in row if k not in CONTINUE_MAY_CHANGE]
         differ = [f"{k} {src[k]!r} there, {row[k]!r} here" for k in fixed if str(src[k]) != str(row[k])]
         if differ:
