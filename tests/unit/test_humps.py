@@ -60,3 +60,16 @@ def test_the_span_table_and_the_command_line(tmp_path, capsys):
     humps.main([str(run), "--from", "1.5"])
     out = capsys.readouterr().out
     assert "melt count" in out and "mass balance max" in out
+
+
+def test_a_run_without_sections_is_refused_by_name(tmp_path):
+    """A series with no finite section mass balance (not a window run, or stopped before the bead formed), or
+    no series at all, is an error naming the file, not an empty table."""
+    t = np.arange(0.0, 1.0, 0.01)
+    xr.Dataset({"t": ("time", t), "n_liquid": ("time", np.ones_like(t)),
+                "mass_balance_ratio": ("time", np.full_like(t, np.nan))}, coords={"time": t}).to_netcdf(
+        tmp_path / "timeseries.nc")
+    with pytest.raises(SystemExit, match="no bead cross-sections.*domain: window"):
+        humps.main([str(tmp_path)])
+    with pytest.raises(SystemExit, match="no time series"):
+        humps.main([str(tmp_path / "elsewhere")])

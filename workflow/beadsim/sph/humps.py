@@ -50,7 +50,13 @@ def read_series(run_dir: str | Path) -> pd.DataFrame:
     (NaN between sections)."""
     import xarray as xr
 
-    with xr.open_dataset(Path(run_dir) / "timeseries.nc") as ds:
+    path = Path(run_dir) / "timeseries.nc"
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: no time series (not an SPH run folder, or the run has not started)")
+    with xr.open_dataset(path) as ds:
+        if "mass_balance_ratio" not in ds or not np.isfinite(ds["mass_balance_ratio"].values).any():
+            raise ValueError(f"{path}: no bead cross-sections in the series; they are taken in moving-window runs "
+                             "(domain: window) once the bead has formed")
         cols = [c for c in (*QUANTITIES, "mass_balance_ratio") if c in ds]
         return pd.DataFrame({c: ds[c].values for c in cols}, index=pd.Index(ds["t"].values, name="t"))
 
@@ -92,7 +98,10 @@ def main(argv=None) -> None:
     ap.add_argument("--window", type=float, default=0.5, help="seconds of pool state averaged before each lag")
     ap.add_argument("--span", type=float, default=0.5, help="seconds per row of the span table")
     args = ap.parse_args(argv)
-    series = read_series(args.run_dir)
+    try:
+        series = read_series(args.run_dir)
+    except (FileNotFoundError, ValueError) as err:
+        raise SystemExit(f"error: {err}") from None
     with pd.option_context("display.width", 160, "display.max_columns", None, "display.max_rows", 200,
                            "display.float_format", "{:.2f}".format):
         print(f"correlation of each quantity's mean over the {args.window} s ending <lag> before a section with "
