@@ -32,11 +32,12 @@ def lead_correlation(t: np.ndarray, x: np.ndarray, t_sections: np.ndarray, y: np
     [t_s - L - window, t_s - L) and ``y`` at each section time t_s. Sections whose window holds no sample are
     left out; NaN where fewer than three sections remain or either side is constant."""
     t, x = np.asarray(t, float), np.asarray(x, float)
+    t, x = t[np.isfinite(x)], x[np.isfinite(x)]
     out = []
     for lag in lags:
         lead, keep = [], []
         for ts, ys in zip(t_sections, y):
-            s = (t >= ts - lag - window) & (t < ts - lag) & np.isfinite(x)
+            s = (t >= ts - lag - window) & (t < ts - lag)
             if s.any() and np.isfinite(ys):
                 lead.append(x[s].mean())
                 keep.append(ys)
