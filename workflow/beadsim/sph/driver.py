@@ -1783,9 +1783,8 @@ class BeadRun:
                 "units": "mm", "long_name": f"{what}: column tops (height map, the bead metrics' profile)"})
             ds["section_height_mass_mm"] = ("y_section", h_mass, {
                 "units": "mm", "long_name": f"{what}: particles per column at the lattice's density"})
-        tmp = self.out / "timeseries.nc.tmp"
-        ds.to_netcdf(tmp, engine="scipy")
-        os.replace(tmp, self.out / "timeseries.nc")
+        with io.atomic_path(self.out / "timeseries.nc") as tmp:
+            ds.to_netcdf(tmp, engine="scipy")
         self.series_written = time.perf_counter()
 
     def checkpoint(self) -> None:
@@ -1798,13 +1797,13 @@ class BeadRun:
         if not is_rank0(self.lmp):
             return
         os.replace(rdir / "restart.tmp.bin", rdir / "restart.bin")
-        np.savez(rdir / "state.tmp.npz", state=json.dumps(asdict(self.state)), max_t=max_t,
-                 face_area=self.per_id.face_area, wire_origin=self.per_id.wire_origin,
-                 released=self.per_id.released, landed=self.per_id.landed,
-                 series=json.dumps(self.series),
-                 profiles=json.dumps([[np.asarray(a).tolist() for a in prof] for prof in self.profiles]),
-                 particle_steps=self.particle_steps)
-        os.replace(rdir / "state.tmp.npz", rdir / "state.npz")
+        with io.atomic_path(rdir / "state.npz") as tmp:
+            np.savez(tmp, state=json.dumps(asdict(self.state)), max_t=max_t,
+                     face_area=self.per_id.face_area, wire_origin=self.per_id.wire_origin,
+                     released=self.per_id.released, landed=self.per_id.landed,
+                     series=json.dumps(self.series),
+                     profiles=json.dumps([[np.asarray(a).tolist() for a in prof] for prof in self.profiles]),
+                     particle_steps=self.particle_steps)
         self._write_series()
 
     def _read_checkpoint(self) -> None:
