@@ -8,6 +8,7 @@ import xarray as xr
 from beadsim.sph import humps
 
 PERIOD, DELAY = 2.0, 0.55  # s: the sections repeat the melt count 0.55 s later
+LEAD = 0.3  # s: the beam's share on the solid wire runs this much ahead of the melt count
 
 
 def _series(tmp_path):
@@ -19,8 +20,12 @@ def _series(tmp_path):
     mb = np.full_like(t, np.nan)
     sections = np.isclose(t / 0.05, np.round(t / 0.05))
     mb[sections] = 1 + 0.5 * np.sin(2 * np.pi * (t[sections] - DELAY) / PERIOD)
+    # absorbed beam 500 W; the solid wire's share 0.02 + 0.01 sin(2 pi (t + LEAD) / PERIOD), booked as running
+    # sums (the ledger's): its integral
+    e_wire = 500 * (0.02 * t - 0.01 * PERIOD / (2 * np.pi) * np.cos(2 * np.pi * (t + LEAD) / PERIOD))
     ds = xr.Dataset({"t": ("time", t), "n_liquid": ("time", 300 + 40 * swell),
                      "pool_x_max": ("time", 2e-3 - 0.5e-3 * swell), "wire_tip_s": ("time", np.full_like(t, 1e-3)),
+                     "E_beam": ("time", 500 * t), "E_beam_solid_wire": ("time", e_wire),
                      "mass_balance_ratio": ("time", mb)}, coords={"time": t})
     ds.to_netcdf(tmp_path / "timeseries.nc")
     return tmp_path
@@ -37,6 +42,26 @@ def test_the_lag_at_which_sections_follow_the_pool_is_found(tmp_path):
     assert table.loc[0.3, "pool front (mm)"] < -0.999
     assert abs(table.loc[0.3 + 0.5, "melt count"]) < 0.1  # a quarter period off (3.2 periods of sections)
     assert table["wire tip (mm)"].isna().all()
+    assert "pool width (mm)" not in table  # not in this series
+
+
+def test_the_beam_share_on_the_wire_comes_from_the_running_sums_and_leads(tmp_path):
+    """The share per sample interval is the running sum's increment over the beam's: the interval's mean of
+    0.02 + 0.01 sin(...); a share running LEAD ahead of the melt count peaks LEAD further back, and the
+    summary lists it before the melt count."""
+    series = humps.read_series(_series(tmp_path))
+    t = series.index.values
+    share = series["beam_share_solid_wire"].values
+    assert np.isnan(share[0])
+    mid = 0.5 * (t[1:] + t[:-1])  # the mean over an interval of 0.01 s is the midpoint value to 2e-6
+    assert share[1:] == pytest.approx(0.02 + 0.01 * np.sin(2 * np.pi * (mid + LEAD) / PERIOD), abs=1e-5)
+    table = humps.lag_table(series, t_from=1.5)
+    assert table["beam on solid wire"].idxmax() == pytest.approx(DELAY - 0.25 + LEAD)
+    top = humps.strongest(table).sort_values("lag (s)", ascending=False)
+    assert top.loc["beam on solid wire", "r"] > 0.999
+    assert top.index[0] == "beam on solid wire"
+    assert top.loc["melt count", "lag (s)"] == pytest.approx(DELAY - 0.25)
+    assert np.isnan(top.loc["wire tip (mm)", "lag (s)"])
 
 
 def test_lead_correlation_leaves_out_sections_without_history():
