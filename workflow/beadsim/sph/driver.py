@@ -32,6 +32,7 @@ import json
 import logging
 import math
 import dataclasses
+import functools
 import os
 import time
 from dataclasses import asdict, dataclass, field
@@ -332,6 +333,7 @@ def lucy_kernel(r: np.ndarray, h: float) -> np.ndarray:
     return 105.0 / (16.0 * math.pi * h ** 3) * (1 + 3 * q) * (1 - q) ** 3
 
 
+@functools.lru_cache(maxsize=16)
 def lattice_volume_fraction(dx: float, h: float) -> float:
     """Kernel volume fraction sum_j dx^3 W(r_j, h) (self included) of a particle inside a simple-cubic lattice
     of spacing dx (m) with full kernel support: the reference of :func:`compression_density`."""
@@ -377,14 +379,12 @@ def compression_density(x_all: np.ndarray, sources: np.ndarray, dx: float, h: fl
     # the targets' neighbours lie within 2 h of a source
     box = within_box(x_all, xs.min(axis=0) - 2 * h, xs.max(axis=0) + 2 * h)
     tree = cKDTree(x_all[box])
-    # the targets: every particle within h of a source, the sources themselves included (distance 0)
-    near = np.union1d(cKDTree(xs).sparse_distance_matrix(tree, h, output_type="ndarray")["j"],
-                      np.searchsorted(box, sources))
-    # each target with its neighbours: sum over the pairs (the target itself, listed or not, added once below)
+    # the targets: every particle within h of a source, the sources themselves included (the "ndarray" output
+    # of sparse_distance_matrix keeps pairs at distance 0, and a source lies in the tree at its own position)
+    near = np.unique(cKDTree(xs).sparse_distance_matrix(tree, h, output_type="ndarray")["j"])
+    # each target with its neighbours, itself included once (distance 0): sum over the pairs
     pairs = cKDTree(x_all[box[near]]).sparse_distance_matrix(tree, h, output_type="ndarray")
-    other = pairs["j"] != near[pairs["i"]]
-    w = lucy_kernel(pairs["v"][other], h)
-    phi = dx ** 3 * (lucy_kernel(np.zeros(1), h)[0] + np.bincount(pairs["i"][other], w, len(near)))
+    phi = dx ** 3 * np.bincount(pairs["i"], lucy_kernel(pairs["v"], h), len(near))
     return box[near], rho0 * phi / lattice_volume_fraction(dx, h)
 
 
@@ -413,8 +413,14 @@ LOOSE_MELT_RELAX_STEPS = 200
 
 
 def within_box(x_all: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """Indices of the particles of ``x_all`` (N, 3) inside the box [lo, hi] (m)."""
-    return np.flatnonzero(((x_all >= lo) & (x_all <= hi)).all(axis=1))
+    """Indices of the particles of ``x_all`` (N, 3) inside the box [lo, hi] (m). One mask built in place,
+    a column at a time (5x quicker than comparing the (N, 3) array whole: 0.05 against 0.26 ms at 7.5k
+    particles, called three times a chunk)."""
+    inside = (x_all[:, 0] >= lo[0]) & (x_all[:, 0] <= hi[0])
+    for k in (1, 2):
+        inside &= x_all[:, k] >= lo[k]
+        inside &= x_all[:, k] <= hi[k]
+    return np.flatnonzero(inside)
 
 
 def mean_nearest3(x_all: np.ndarray, xq: np.ndarray, lo: np.ndarray, hi: np.ndarray, tree: cKDTree) -> np.ndarray:
@@ -903,6 +909,9 @@ class BeadRun:
         cmd("pair_style hybrid/overlay " + " ".join(styles))
         for line in coeffs:
             cmd(line)
+        # Skin 0.2 dx. 0.3 dx rebuilds the lists less often (a mode 1 state, 7,490 particles, 3,000 steps in plain
+        # LAMMPS: 570 / 364 builds, 13.27 / 12.73 s) but moves test_height_function_on_two_ranks' surface work
+        # from 1 % to 6 % between the ranks at 0.03 s: left until that test's scatter is understood
         skin = 0.2 * self.num.dx
         cmd(f"neighbor {skin:.9g} bin")
         cmd("neigh_modify every 1 delay 0 check yes")
