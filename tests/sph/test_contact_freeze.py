@@ -44,7 +44,7 @@ def test_contact_freeze_holds_the_melt_that_touches_cold_plate(tmp_path):
         assert m["held_melt_share"] == pytest.approx(np.mean(half), rel=1e-12)
         np.testing.assert_allclose(v[pin], np.broadcast_to(run.geom.substrate_velocity, (pin.sum(), 3)))
         # one more chunk: the held melt moves with the plate, exactly; the free melt does not
-        run.deck(f"run {run.chunk} pre yes post no")
+        run._run_lammps(setup=True)
         # by id: the setup may sort the local particles spatially (LAMMPS does when it rebuilds the neighbour
         # lists on a multiple of its sort interval)
         now = run._ids()
@@ -56,3 +56,30 @@ def test_contact_freeze_holds_the_melt_that_touches_cold_plate(tmp_path):
         assert np.abs(moved[free] - step).max() > 1e-7
     finally:
         run.close()
+
+
+@pytest.mark.slow
+def test_frozen_group_per_chunk_is_the_dynamic_group(tmp_path):
+    """With the cohesion the frozen group (fix setforce's) is evaluated once before each chunk instead of at every
+    step (types and holds change only between chunks): the same run, particle for particle, as with LAMMPS's
+    dynamic group, through melting, holds, wire slices fed and window layers added."""
+    p = mode_params(1, resolution_mm=0.5, domain="window", sim_time_s=0.1, surface_tension=True,
+                    artificial_viscosity=0.2, wetting_pressure_balance=True, wetting_angle_deg=72.7,
+                    contact_freeze=True, wire_feed_start="immediate")
+    state = {}
+    for per_chunk in (True, False):
+        run = BeadRun(p, tmp_path / str(per_chunk))
+        run.frozen_per_chunk = per_chunk
+        run.open(resume=False)
+        try:
+            run.run()
+            assert run.n_pinned > 0 and (run._types() == TYPE_LIQUID).sum() > 10
+            order = np.argsort(run._ids())
+            state[per_chunk] = (run._ids()[order], run._x()[order], run._v()[order], run._e()[order])
+        finally:
+            run.close()
+        deck = (tmp_path / str(per_chunk) / "deck.in").read_text()
+        assert ("group frozen dynamic" in deck) != per_chunk
+        assert (deck.count("group frozen variable frozen") > 100) == per_chunk
+    for a, b in zip(state[True], state[False]):
+        np.testing.assert_array_equal(a, b)
