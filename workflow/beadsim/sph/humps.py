@@ -112,7 +112,8 @@ def span_table(series: pd.DataFrame, t_from: float, span: float = 0.5) -> pd.Dat
         row = {"from (s)": a}
         for name, (label, scale) in _quantities().items():
             if name in series:
-                row[label] = float(np.nanmean(series[name].values[s])) * scale if s.any() else np.nan
+                v = series[name].values[s]
+                row[label] = float(v[np.isfinite(v)].mean()) * scale if np.isfinite(v).any() else np.nan
         mb = series["mass_balance_ratio"].values[s]
         mb = mb[np.isfinite(mb)]
         row["mass balance min"] = mb.min() if len(mb) else np.nan
