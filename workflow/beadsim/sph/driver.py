@@ -913,7 +913,8 @@ class BeadRun:
             cmd(line)
         # Skin 0.2 dx. 0.3 dx rebuilds the lists less often (a mode 1 state, 7,490 particles, 3,000 steps in plain
         # LAMMPS: 570 / 364 builds, 13.27 / 12.73 s) but moves test_height_function_on_two_ranks' surface work
-        # from 1 % to 6 % between the ranks at 0.03 s: left until that test's scatter is understood
+        # from 1 % to 6 % between the ranks at 0.03 s (once the melt flows, round-off parts the ranks' trajectories;
+        # that test wants a per-chunk check of the forces first)
         skin = 0.2 * self.num.dx
         cmd(f"neighbor {skin:.9g} bin")
         cmd("neigh_modify every 1 delay 0 check yes")
