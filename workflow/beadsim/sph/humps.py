@@ -97,9 +97,9 @@ def strongest(table: pd.DataFrame) -> pd.DataFrame:
     (NaN for a column without any)."""
     rows = {}
     for col in table:
-        r = table[col]
-        lag = r.abs().idxmax() if r.notna().any() else np.nan
-        rows[col] = {"lag (s)": lag, "r": r[lag] if r.notna().any() else np.nan}
+        r = table[col].dropna()
+        lag = r.abs().idxmax() if len(r) else np.nan
+        rows[col] = {"lag (s)": lag, "r": r[lag] if len(r) else np.nan}
     return pd.DataFrame(rows).T
 
 
@@ -113,7 +113,8 @@ def span_table(series: pd.DataFrame, t_from: float, span: float = 0.5) -> pd.Dat
         for name, (label, scale) in _quantities().items():
             if name in series:
                 v = series[name].values[s]
-                row[label] = float(v[np.isfinite(v)].mean()) * scale if np.isfinite(v).any() else np.nan
+                v = v[np.isfinite(v)]
+                row[label] = float(v.mean()) * scale if len(v) else np.nan
         mb = series["mass_balance_ratio"].values[s]
         mb = mb[np.isfinite(mb)]
         row["mass balance min"] = mb.min() if len(mb) else np.nan
