@@ -115,24 +115,33 @@ def test_smoothed_loose_melt_ceiling_on_two_ranks(tmp_path):
 @pytest.mark.mpi
 def test_height_function_on_two_ranks(tmp_path):
     """surface_force height_function: the column height map is built from the gathered positions (the same on
-    every rank) and each rank writes the forces of the particles it owns. The plain SPH melt is more chaotic than
-    the cohesive one: 1 and 2 ranks agree to round-off while the pool forms and drift apart once it splashes
-    (measured 2026-12-05 over 0.25 s: same up to 0.03 s, surface work 0.351 / 0.351 uJ there; at 0.25 s 24.7 /
-    26.9 uJ, stored energy 1.5 %, 2 / 3 single particles thrown out). So compare over the first 0.03 s, where a
-    force written to the wrong particle would show. The stored energy there is 0.5 %, not 0.1 %: with numpy's
-    AVX-512 kernels switched off (NPY_DISABLE_CPU_FEATURES="AVX512_SPR AVX512_ICL X86_V4", as on a CPU
-    without them) it read 101.99 / 101.87 J (0.12 % apart; 2026-12-06)."""
-    params = small_case(**HEIGHT_FUNCTION, sim_time_s=0.03)
+    every rank) and each rank writes the forces of the particles it owns, held over the chunk. Checked at every
+    chunk (tests/sph/mpi_hf.py): the forces the ranks wrote, gathered by id, equal those computed afresh from the
+    gathered particles in another order, and at the chunk's end each particle still carries the force written at
+    its start, including those that changed rank (measured over 0.1 s: 466 chunks, ~3,600 forces, 17-24
+    particles changed rank while forced, every difference 0.0; writing the forces in gather order instead of by
+    id reads 1.9e-4 N apart).
+
+    The plain SPH melt is chaotic: round-off (the ranks' summation order, or the neighbour skin) parts 1 and 2
+    ranks once the pool splashes, so whole-run figures are compared loosely (measured at 0.1 s: stored energy
+    0.8 % apart with a skin of 0.2 dx, 2.5 % with 0.3 dx, where the skin alone moved one rank's by 1.9 %;
+    surface work 20-23 % apart)."""
+    params = small_case(**HEIGHT_FUNCTION, sim_time_s=0.1)
     one = run_case(params, tmp_path / "one")
-    two = run_mpi(params, tmp_path / "two", tasks=2, timeout=TIMEOUT)
+    two = run_mpi(params, tmp_path / "two", tasks=2, timeout=TIMEOUT,
+                  entry=(str(Path(__file__).with_name("mpi_hf.py")),))
+    check = json.loads((tmp_path / "two" / "hf_check.json").read_text())
+    assert check["chunks"] > 100 and check["missing"] == 0
+    assert check["forced"] > 1000 and check["moved"] > 0 and check["f_max"] > 1e-5
+    assert check["written_diff"] <= 1e-12 * check["f_max"] and check["carried_diff"] == 0.0
     assert two["n_particles"] + two["spatter_particles"] == one["n_particles"] + one["spatter_particles"]
     assert two["n_steps"] == one["n_steps"]
     assert abs(two["energy_balance_error"]) < 1e-3 and abs(one["energy_balance_error"]) < 1e-3
-    assert one["surface_work_J"] > 1e-7
-    assert two["surface_work_J"] == pytest.approx(one["surface_work_J"], rel=0.02)
+    assert one["surface_work_J"] > 1e-6 and two["surface_work_J"] > 1e-6
     series = [xr.load_dataset(tmp_path / name / "timeseries.nc") for name in ("one", "two")]
-    assert abs(int(series[1]["n_liquid"][-1]) - int(series[0]["n_liquid"][-1])) <= 2
-    assert series[1]["E_internal"][-1].item() == pytest.approx(series[0]["E_internal"][-1].item(), rel=5e-3)
+    late = [s["n_liquid"].where(s["t"] > 0.05).mean().item() for s in series]
+    assert late[0] > 20 and late[1] == pytest.approx(late[0], rel=0.10)
+    assert series[1]["E_internal"][-1].item() == pytest.approx(series[0]["E_internal"][-1].item(), rel=0.05)
 
 
 @pytest.mark.mpi
