@@ -410,6 +410,10 @@ LOOSE_MELT_D3 = 1.0
 #: the fastest particle reached 1.25 m/s relaxing over 30 steps (threshold 1.07 dx), 0.66 over 100 and 0.74
 #: over 200 (threshold dx); 200 steps are 2.2 ms at dx 0.4, about five capillary times sqrt(rho dx^3 / sigma).
 LOOSE_MELT_RELAX_STEPS = 200
+#: Neighbour-list skin, in dx. 0.3 dx rebuilds the lists less often than 0.2 dx (a mode 1 state, 7,490 particles,
+#: 3,000 steps in plain LAMMPS: 364 / 570 builds, 12.73 / 13.27 s). Round-off then parts a flowing melt's
+#: trajectory from what it was with 0.2 dx, as it parts 1 and 2 ranks (tests/sph/test_mpi.py).
+NEIGHBOUR_SKIN_DX = 0.3
 
 
 def within_box(x_all: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -911,18 +915,14 @@ class BeadRun:
         cmd("pair_style hybrid/overlay " + " ".join(styles))
         for line in coeffs:
             cmd(line)
-        # Skin 0.2 dx. 0.3 dx rebuilds the lists less often (a mode 1 state, 7,490 particles, 3,000 steps in plain
-        # LAMMPS: 570 / 364 builds, 13.27 / 12.73 s) but moves test_height_function_on_two_ranks' surface work
-        # from 1 % to 6 % between the ranks at 0.03 s (once the melt flows, round-off parts the ranks' trajectories;
-        # that test wants a per-chunk check of the forces first)
-        skin = 0.2 * self.num.dx
+        skin = NEIGHBOUR_SKIN_DX * self.num.dx
         cmd(f"neighbor {skin:.9g} bin")
         cmd("neigh_modify every 1 delay 0 check yes")
         smooth = self.p["loose_melt_smoothing"] if self.loose_ceiling else 0.0
         if smooth > 0:
             # the smoothed ceiling averages d3 over particles up to `smooth` dx from a melt particle, and each of
             # those needs its three nearest neighbours (up to ~1.5 dx in loose melt): ghosts must reach that
-            # far beyond the rank, past the kernel cutoff + skin (2.7 dx by default)
+            # far beyond the rank, past the kernel cutoff + skin (2.8 dx by default)
             reach = max(self.num.h, (smooth + 2.0) * self.num.dx) + skin
             cmd(f"comm_modify vel yes cutoff {reach:.9g}")
         else:
