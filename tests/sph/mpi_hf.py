@@ -5,7 +5,8 @@ the ranks wrote, gathered by particle id, are compared with the forces computed 
 particles in another order (reversed ids), and at its end, after particles have changed rank, with what was
 written at its start (the force is held over the chunk and must travel with its particle). Rank 0 writes the
 counts to OUTDIR/hf_check.json: chunks, particles forced, the largest difference of each kind (N), the largest
-force (N), and how many forced particles changed rank during a chunk.
+force (N), how many forced particles changed rank during a chunk, and how many of the gathered particles no
+rank owned (missing).
 """
 
 import json
@@ -24,10 +25,11 @@ def main(outdir: str) -> None:
     from beadsim.sph import driver, heightfn, mpi_main
 
     comm = MPI.COMM_WORLD
-    counts = {"chunks": 0, "forced": 0, "written_diff": 0.0, "carried_diff": 0.0, "f_max": 0.0, "moved": 0}
+    counts = {"chunks": 0, "forced": 0, "written_diff": 0.0, "carried_diff": 0.0, "f_max": 0.0, "moved": 0,
+              "missing": 0}
     surface_forces, heightfn_forces = driver.BeadRun._surface_forces, heightfn.surface_forces
     calls: list = []
-    held: dict = {}  # id -> (force, rank) written at the chunk's start
+    held: dict = {}  # ids, forces and owning ranks as written at the chunk's start, in id order
 
     def recorded(*args, **kwargs):  # the driver's call: keep its arguments (the grid) for the fresh computation
         calls.append((args, kwargs))
@@ -50,18 +52,18 @@ def main(outdir: str) -> None:
         calls.clear()
         surface_forces(self)
         (x, movable, grid, *rest), kwargs = calls[-1]
-        ids_all = np.sort(np.concatenate(comm.allgather(self._ids())))
-        order = np.argsort(-ids_all)  # the driver gathers in id order; compute again in the reverse one
+        ids, f, rank = written(self)
+        ids_all = np.sort(ids)  # the driver's gathered particles, in id order
+        order = np.argsort(-ids_all)  # compute again in the reverse order
         kwargs = dict(kwargs, mapped=kwargs["mapped"][order])
         f_fresh = np.empty_like(x)
         f_fresh[order] = heightfn_forces(x[order], movable[order], grid, *rest, **kwargs)[0]
-        ids, f, rank = written(self)
         where = np.searchsorted(ids_all, ids)
         counts["chunks"] += 1
         counts["forced"] += int((np.abs(f).max(axis=1) > 0).sum())
         counts["f_max"] = max(counts["f_max"], float(np.abs(f_fresh).max()))
         counts["written_diff"] = max(counts["written_diff"], float(np.abs(f - f_fresh[where]).max()))
-        counts["missing"] = counts.get("missing", 0) + len(ids_all) - len(ids)
+        counts["missing"] += len(x) - len(ids)
         sort = np.argsort(ids)
         held.update(ids=ids[sort], f=f[sort], rank=rank[sort])
 
