@@ -53,7 +53,8 @@ def main(outdir: str) -> None:
         surface_forces(self)
         (x, movable, grid, *rest), kwargs = calls[-1]
         ids, f, rank = written(self)
-        ids_all = np.sort(ids)  # the driver's gathered particles, in id order
+        sort = np.argsort(ids)
+        ids_all = ids[sort]  # the driver's gathered particles, in id order
         order = np.argsort(-ids_all)  # compute again in the reverse order
         kwargs = dict(kwargs, mapped=kwargs["mapped"][order])
         f_fresh = np.empty_like(x)
@@ -64,8 +65,7 @@ def main(outdir: str) -> None:
         counts["f_max"] = max(counts["f_max"], float(np.abs(f_fresh).max()))
         counts["written_diff"] = max(counts["written_diff"], float(np.abs(f - f_fresh[where]).max()))
         counts["missing"] += len(x) - len(ids)
-        sort = np.argsort(ids)
-        held.update(ids=ids[sort], f=f[sort], rank=rank[sort])
+        held.update(ids=ids_all, f=f[sort], rank=rank[sort])
 
     driver.heightfn.surface_forces = recorded
     driver.BeadRun._surface_forces = checked
