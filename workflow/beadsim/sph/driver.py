@@ -812,9 +812,11 @@ class BeadRun:
         cmd("atom_modify map array")
         cmd("boundary f f f")
         cmd("newton on")
-        pad = 2 * h
+        # fluid particles beyond the block are deleted as spatter at chunk ends (_remove_spatter, 2 dx out); the
+        # box reaches 2 dx further, so a droplet must outrun ~2 dx per chunk (~4 m/s at dx 0.4) to be lost
+        pad = 2 * h + 2 * d
         cmd(f"region box block {g.x_lo - pad:.9g} {g.x_hi + pad:.9g} {g.y_lo - pad:.9g} {g.y_hi + pad:.9g} "
-            f"{g.z_lo - pad:.9g} {g.box_z_hi:.9g} units box")
+            f"{g.z_lo - pad:.9g} {g.box_z_hi + pad:.9g} units box")
         cmd(f"create_box {scene.N_TYPES} box")
         cmd(f"lattice sc {d:.9g} origin 0.5 0.5 0.5")
         cmd(f"region substrate block {g.x_lo:.9g} {g.x_hi:.9g} {g.y_lo:.9g} {g.y_hi:.9g} {g.z_lo:.9g} 0 "
@@ -1169,13 +1171,12 @@ class BeadRun:
         g, d = self.geom, self.geom.dx
         x, types = self._x(), self._types()
         beyond = ((x[:, 0] > g.x_hi + 2 * d) | (np.abs(x[:, 1]) > g.y_hi + 2 * d) | (x[:, 2] < g.z_lo - 2 * d)
-                  | (x[:, 2] > g.box_z_hi - d / 2))
+                  | (x[:, 2] > g.box_z_hi - d / 2) | (x[:, 0] < g.x_lo - 2 * d))
         # The moving window's rear face deletes what is behind it, but only when a layer enters at the front
-        # (every dx / V_s): a droplet that ran off the plate's edge behind it fell out of the box before that
-        # (mode 2, efficiency 0.45, 2.45 s). So the tests below and beside the block apply behind it too; only
-        # the test behind the rear face is left to the rear face.
-        if not g.moving_window:
-            beyond |= x[:, 0] < g.x_lo - 2 * d
+        # (every dx / V_s, which carries the plate and its bead 1 dx past it): a droplet that ran off the plate's
+        # edge behind it (mode 2, efficiency 0.45, 2.45 s) or flew back over the bead (mode 1, height function
+        # with contact_freeze, 0.87 m/s at 0.249 s) left the box before that. So every test applies in the
+        # window too; what 2 dx behind the rear face is fluid has flown there.
         out = np.isin(types, FLUID_TYPES) & beyond
         gone = allgather_rows(self.lmp, self._ids()[out])
         if len(gone) == 0:
