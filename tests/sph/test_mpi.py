@@ -91,25 +91,33 @@ def test_moving_window_on_two_ranks(tmp_path):
 @pytest.mark.mpi
 def test_smoothed_loose_melt_ceiling_on_two_ranks(tmp_path):
     """The smoothed loose-melt ceiling averages d3 over particles up to 1.5 dx from a melt particle, each needing
-    its three nearest neighbours: the deck extends the ghosts' reach (comm_modify cutoff 3.7 dx), and 1 and 2
-    ranks agree as above (measured at 0.25 s: boiled-off energy 0.05 %, late melt count 0.8 %, stored energy
-    0.5 % apart). The ceiling's cap switches on where a neighbourhood's mean d3 crosses the threshold, so the
-    order in which sums are rounded moves the run: at 0.2 s the stored energy read 226.4 / 224.4 J (1 / 2 ranks)
-    with the ceiling's sums in one order and 228.3 / 225.3 J in another (2026-12-05), while a preheat 1e-6 K
-    higher changed it by 3e-7 J; so 2.5 %, not 1 %."""
+    its three nearest neighbours: each rank caps the melt it owns from its own and its ghost particles, and the
+    deck extends the ghosts' reach (comm_modify cutoff 3.8 dx). Checked at every chunk (tests/sph/mpi_ceiling.py):
+    the densities the ranks wrote, gathered by id, against the cap applied afresh to the gathered particles of
+    both ranks in another order.
+
+    Whole-run figures are compared loosely: the cap switches on where a neighbourhood's mean d3 crosses the
+    threshold, so the order of LAMMPS's sums moves the run. On one rank, padding the box by 0-5 dx more (its
+    bins, and with them that order, move; nothing else does) gave late melt counts 76.2-87.6 and stored energies
+    217.7-227.8 J at 0.2 s (2026-12-08), where a preheat 1e-6 K higher moved the energy by 3e-7 J."""
     params = small_case(sim_time_s=0.2, surface_tension=True, artificial_viscosity=0.2,
                         wetting_pressure_balance=True, wetting_angle_deg=72.7, resolidified_density="freeze",
                         density_tolerance=0.5, loose_melt_ceiling=True, loose_melt_d3=0.985,
                         loose_melt_smoothing=1.5)
     one = run_case(params, tmp_path / "one")
-    two = run_mpi(params, tmp_path / "two", tasks=2, timeout=TIMEOUT)
+    two = run_mpi(params, tmp_path / "two", tasks=2, timeout=TIMEOUT,
+                  entry=(str(Path(__file__).with_name("mpi_ceiling.py")),))
     assert "comm_modify vel yes cutoff" in (tmp_path / "two" / "deck.in").read_text()
+    check = json.loads((tmp_path / "two" / "ceiling_check.json").read_text())
+    assert check["chunks"] > 100 and check["melt"] > 10000 and check["capped"] > 100
+    assert check["change_max"] > 1.0  # kg/m^3: the cap acted
+    assert check["diff_max"] <= 1e-9 * 4500 and check["flipped"] == 0
     assert two["n_particles"] == one["n_particles"] and two["n_steps"] == one["n_steps"]
     assert abs(two["energy_balance_error"]) < 1e-3 and abs(one["energy_balance_error"]) < 1e-3
     series = [xr.load_dataset(tmp_path / name / "timeseries.nc") for name in ("one", "two")]
     late = [s["n_liquid"].where(s["t"] > 0.1).mean().item() for s in series]
-    assert late[0] > 20 and late[1] == pytest.approx(late[0], rel=0.10)
-    assert series[1]["E_internal"][-1].item() == pytest.approx(series[0]["E_internal"][-1].item(), rel=0.025)
+    assert late[0] > 20 and late[1] == pytest.approx(late[0], rel=0.25)
+    assert series[1]["E_internal"][-1].item() == pytest.approx(series[0]["E_internal"][-1].item(), rel=0.08)
 
 
 @pytest.mark.mpi

@@ -812,9 +812,11 @@ class BeadRun:
         cmd("atom_modify map array")
         cmd("boundary f f f")
         cmd("newton on")
-        # fluid particles beyond the block are deleted as spatter at chunk ends (_remove_spatter, 2 dx out); the
-        # box reaches 2 dx further, so a droplet must outrun ~2 dx per chunk (~4 m/s at dx 0.4) to be lost
-        pad = 2 * h + 2 * d
+        # the box reaches 2 h (5 dx by default) past the scene on every side, the top included: 3 dx past the
+        # planes beyond which fluid is deleted as spatter at chunk ends (_remove_spatter: 2 dx out of the block;
+        # at the top d/2 below box_z_hi, so 5.5 dx there); a droplet would have to cross 1.2 mm in one chunk
+        # (~6 m/s at dx 0.4) to be lost instead
+        pad = 2 * h
         cmd(f"region box block {g.x_lo - pad:.9g} {g.x_hi + pad:.9g} {g.y_lo - pad:.9g} {g.y_hi + pad:.9g} "
             f"{g.z_lo - pad:.9g} {g.box_z_hi + pad:.9g} units box")
         cmd(f"create_box {scene.N_TYPES} box")
