@@ -28,27 +28,25 @@ def main(outdir: str) -> None:
     counts = {"chunks": 0, "melt": 0, "capped": 0, "change_max": 0.0, "diff_max": 0.0, "flipped": 0}
     ceiling = driver.BeadRun._loose_melt_ceiling
 
-    def gathered(self, *arrays):
-        return [driver.allgather_rows(self.lmp, a) for a in arrays]
-
     def checked(self):
         n = self._nlocal()
-        ids, x, rho, types = gathered(self, self._ids(), self._x()[:n].copy(), self._rho()[:n].copy(),
-                                      self._types()[:n].copy())
+        # gathered before the cap (which lowers rho in place: a copy, as one rank gathers its own array) and after
+        # it; the cap moves no particle, so both gathers list the same particles in the same order
+        ids, x, rho, types = (driver.allgather_rows(self.lmp, a)
+                              for a in (self._ids(), self._x()[:n], self._rho()[:n].copy(), self._types()[:n]))
         ceiling(self)
-        ids_after, rho_after = gathered(self, self._ids(), self._rho()[:n].copy())
+        rho_after = driver.allgather_rows(self.lmp, self._rho()[:n])
         melt = types == TYPE_LIQUID
         if not melt.any():
             return
-        order = np.argsort(-ids)  # the gathered particles in reversed id order
-        ids, x, rho, melt = ids[order], x[order], rho[order], melt[order]
-        fresh = rho.copy()
+        order = np.argsort(-ids)  # compute again with the gathered particles in reversed id order
+        capped = rho[order]
         p = self.p
-        driver.relax_loose_density(fresh, x, np.flatnonzero(melt), self.num.dx, self.mat.rho, self.num.tait_rho0,
-                                   self.chunk, p["loose_melt_d3"], p["loose_melt_smoothing"])
-        sort = np.argsort(ids_after)
-        where = sort[np.searchsorted(ids_after, ids[melt], sorter=sort)]
-        diff = np.abs(rho_after[where] - fresh[melt])
+        driver.relax_loose_density(capped, x[order], np.flatnonzero(melt[order]), self.num.dx, self.mat.rho,
+                                   self.num.tait_rho0, self.chunk, p["loose_melt_d3"], p["loose_melt_smoothing"])
+        fresh = np.empty_like(rho)
+        fresh[order] = capped
+        diff = np.abs(rho_after[melt] - fresh[melt])
         counts["chunks"] += 1
         counts["melt"] += int(melt.sum())
         counts["capped"] += int((fresh[melt] < rho[melt]).sum())
